@@ -1,0 +1,95 @@
+"""Discrete Dynamical Movement Primitives (Ijspeert et al. 2013), vectorised over dimensions.
+
+A DMP turns a start, an end and a few basis-function weights per dimension into a smooth
+n-step trajectory. The forcing term is not multiplied by (end - start), so a movement that
+starts and ends at the same place can still have a shape (the study's arm starts at rest, 0).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from sim.config import DEFAULT_WORLD, WorldConfig
+
+# Spring-damper gains of the transformation system, critically damped (beta = alpha / 4).
+ALPHA_Y = 25.0
+BETA_Y = ALPHA_Y / 4.0
+# The canonical phase decays from 1 to exp(-1) over the movement (pydmps's default, used by
+# the study through explauto), so the forcing term shapes the whole movement.
+ALPHA_X = 1.0
+# Euler integration substeps per output step, for accuracy with stiff forcing.
+INTEGRATION_SUBSTEPS = 10
+
+
+def _basis(n_bfs: int, phase: np.ndarray) -> np.ndarray:
+    """Normalised Gaussian activations (len(phase), n_bfs), centres spaced evenly in time."""
+    centres = np.exp(-ALPHA_X * np.linspace(0.0, 1.0, n_bfs))
+    widths = n_bfs**1.5 / centres / ALPHA_X
+    psi = np.exp(-widths * (phase[:, None] - centres) ** 2)
+    return psi / psi.sum(axis=1, keepdims=True)
+
+
+def _integrate(start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int) -> np.ndarray:
+    """Euler-integrate DMPs of `d` dimensions: (d,), (d,), (d, n_bfs) -> (d, n_steps)."""
+    n_fine = n_steps * INTEGRATION_SUBSTEPS
+    dt = 1.0 / n_fine
+    phase = np.exp(-ALPHA_X * np.arange(n_fine) * dt)
+    forcing = phase[:, None] * (_basis(weights.shape[1], phase) @ weights.T)  # (n_fine, d)
+    y = start.astype(float).copy()
+    yd = np.zeros_like(y)
+    out = np.empty((n_fine, y.size))
+    for k in range(n_fine):
+        ydd = ALPHA_Y * (BETA_Y * (end - y) - yd) + forcing[k]
+        yd = yd + ydd * dt
+        y = y + yd * dt
+        out[k] = y
+    return out[INTEGRATION_SUBSTEPS - 1 :: INTEGRATION_SUBSTEPS].T
+
+
+@functools.lru_cache(maxsize=8)
+def _response_matrix(n_bfs: int, n_steps: int) -> np.ndarray:
+    """(2 + n_bfs, n_steps): the trajectory of a unit start, a unit end and each unit weight.
+
+    The DMP is linear in (start, end, weights) from rest velocity, so integrating each unit
+    input once turns every later rollout into one matrix product.
+    """
+    eye = np.eye(2 + n_bfs)
+    return _integrate(eye[:, 0], eye[:, 1], eye[:, 2:], n_steps)
+
+
+def rollout(
+    start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int = DEFAULT_WORLD.n_steps
+) -> np.ndarray:
+    """Trajectories of `d` DMPs.
+
+    start, end: (d,); weights: (d, n_bfs), already scaled. Returns (d, n_steps): the positions
+    after each of the n_steps equal time steps of a movement lasting 1 (unitless time).
+    """
+    weights = np.atleast_2d(np.asarray(weights, dtype=float))
+    inputs = np.column_stack([np.asarray(start, float), np.asarray(end, float), weights])
+    return inputs @ _response_matrix(weights.shape[1], n_steps)
+
+
+def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
+    """21 arm parameters in [-1, 1] -> (3, n_steps) joint angles in rad, relative to rest.
+
+    Per joint: `arm_bfs` weights then 1 end position. The DMP starts at rest (0); the
+    trajectory is bounded to [-1, 1] and scaled by pi (protocol.md).
+    """
+    per_joint = np.asarray(m, dtype=float).reshape(3, config.arm_bfs + 1)
+    weights = per_joint[:, :-1] * config.dmp_weight_scale
+    traj = rollout(np.zeros(3), per_joint[:, -1], weights, config.n_steps)
+    return np.pi * np.clip(traj, -1.0, 1.0)
+
+
+def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
+    """28 voice parameters in [-1, 1] -> (7, n_steps) articulator values in [-1, 1].
+
+    Per articulator: start, end, then `voice_bfs` weights (protocol.md).
+    """
+    per_art = np.asarray(m, dtype=float).reshape(7, config.voice_bfs + 2)
+    weights = per_art[:, 2:] * config.dmp_weight_scale
+    traj = rollout(per_art[:, 0], per_art[:, 1], weights, config.n_steps)
+    return np.clip(traj, -1.0, 1.0)

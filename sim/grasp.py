@@ -1,0 +1,270 @@
+"""The two grasp backends: the study's distance rules, and grasping through MuJoCo contacts.
+
+Both share one MJCF model and one interface. Per control step the task calls
+`before_step(physics, joint_targets, step)`, then the physics steps, then
+`after_step(physics, step)`; both return the events of that step. `release(physics)` ends a
+movement: everything held is dropped where it is and the arm goes back to rest.
+"""
+
+from __future__ import annotations
+
+import abc
+
+import mujoco
+import numpy as np
+
+from sim import events as ev
+from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.physics import TOYS, PlayroomPhysics
+
+# Collision bits of the MJCF model (models/playroom.xml).
+HAND_BIT, STICK_BIT, TOY_BIT = 1, 2, 4
+
+
+class GraspBackend(abc.ABC):
+    """What the hand holds and what the stick's tip holds, and how that changes."""
+
+    name: str
+
+    def __init__(self, config: WorldConfig = DEFAULT_WORLD) -> None:
+        self.config = config
+        self.hand_holds: str | None = None  # "stick", "toy1", ... or None
+        self.stick_holds: int | None = None  # index of the toy on the stick's tip
+
+    def begin(self, physics: PlayroomPhysics) -> None:
+        """Start of a movement: nothing is held."""
+        self.hand_holds = None
+        self.stick_holds = None
+
+    @abc.abstractmethod
+    def before_step(
+        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
+    ) -> list[ev.Event]:
+        """Drive the arm toward joint_targets (3,) rad, relative to rest."""
+
+    @abc.abstractmethod
+    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """Look at the world after the step and attach what the rules say."""
+
+    @abc.abstractmethod
+    def release(self, physics: PlayroomPhysics) -> None:
+        """Drop everything where it is and put the arm back at rest."""
+
+    def _free_toy_mask(self) -> np.ndarray:
+        """(3,) bool: toys that neither the hand nor the stick holds."""
+        free = np.ones(len(TOYS), dtype=bool)
+        if self.stick_holds is not None:
+            free[self.stick_holds] = False
+        if self.hand_holds in TOYS:
+            free[TOYS.index(self.hand_holds)] = False
+        return free
+
+
+def _arm_to_rest(physics: PlayroomPhysics) -> None:
+    d = physics.data.ptr
+    d.qpos[physics.arm_qpos] = 0.0
+    d.qvel[physics.arm_dof] = 0.0
+    d.ctrl[:] = 0.0
+    mujoco.mj_kinematics(physics.model.ptr, d)
+
+
+class KinematicGrasp(GraspBackend):
+    """The study's rules (protocol.md): the arm follows its targets exactly and objects attach
+    by distance. Held objects are placed, not simulated."""
+
+    name = "kinematic"
+
+    def before_step(
+        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
+    ) -> list[ev.Event]:
+        d = physics.data.ptr
+        d.qpos[physics.arm_qpos] = joint_targets
+        mujoco.mj_kinematics(physics.model.ptr, d)
+        events = self._attach_by_distance(physics, step)
+        self._carry(physics)
+        return events
+
+    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        return []
+
+    def _attach_by_distance(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """The study's rules: a free hand takes the stick, else the first toy within reach; a
+        held stick's tip catches the first free toy within reach if it holds none."""
+        cfg = self.config
+        events: list[ev.Event] = []
+        positions = physics.tracked_positions()  # hand, handle, toy1-3
+        free = self._free_toy_mask()
+        if self.hand_holds is None:
+            near = np.hypot(*(positions[1:] - positions[0]).T) < cfg.grasp_distance
+            near[1:] &= free
+            if near.any():
+                first = int(np.argmax(near))
+                if first == 0:
+                    self.hand_holds = "stick"
+                    events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
+                else:
+                    self.hand_holds = TOYS[first - 1]
+                    free[first - 1] = False
+                    events.append(ev.Event(ev.TOY_GRASPED, step, obj=TOYS[first - 1], by="hand"))
+        # A stick lying on the table catches nothing: only a stick in the hand is a tool.
+        if self.hand_holds == "stick" and self.stick_holds is None:
+            tip = self._held_stick_tip(physics)
+            near = (np.hypot(*(positions[2:] - tip).T) < cfg.catch_distance) & free
+            if near.any():
+                self.stick_holds = int(np.argmax(near))
+                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=TOYS[self.stick_holds], by="stick"))
+        return events
+
+    def _held_stick_tip(self, physics: PlayroomPhysics) -> np.ndarray:
+        """The tip of the stick held by the hand: the handle is at the hand and the stick
+        points along the hand's orientation."""
+        yaw = physics.hand_angle()
+        return physics.hand_position() + self.config.stick_length * np.array(
+            [np.cos(yaw), np.sin(yaw)]
+        )
+
+    def _carry(self, physics: PlayroomPhysics) -> None:
+        """Place held objects: the handle at the hand, toys at the hand or the stick's tip."""
+        if self.hand_holds is None:
+            return
+        poses = physics.object_poses()
+        if self.hand_holds == "stick":
+            poses[0] = (*physics.hand_position(), physics.hand_angle())
+            if self.stick_holds is not None:
+                poses[1 + self.stick_holds, :2] = self._held_stick_tip(physics)
+        else:
+            poses[1 + TOYS.index(self.hand_holds), :2] = physics.hand_position()
+        physics.set_object_poses(poses)
+
+    def release(self, physics: PlayroomPhysics) -> None:
+        self.hand_holds = None
+        self.stick_holds = None
+        _arm_to_rest(physics)
+
+
+class PhysicalGrasp(GraspBackend):
+    """Grasping through contact: position servos track the targets through the dynamics; the
+    hand takes the stick when it touches the handle geom, or a toy when it touches it; the
+    stick's tip catches a toy it touches. A grasp activates a weld equality holding the current
+    relative pose. Unheld objects are pushed by whatever touches them."""
+
+    name = "physical"
+
+    def __init__(self, config: WorldConfig = DEFAULT_WORLD) -> None:
+        super().__init__(config)
+        self._base_conaffinity: np.ndarray | None = None
+
+    def _welds(self, physics: PlayroomPhysics) -> dict[str, int]:
+        m = physics.model.ptr
+        names = ["hand_stick"] + [f"hand_{t}" for t in TOYS] + [f"stick_{t}" for t in TOYS]
+        return {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n) for n in names}
+
+    def begin(self, physics: PlayroomPhysics) -> None:
+        super().begin(physics)
+        if self._base_conaffinity is None:
+            self._base_conaffinity = physics.model.ptr.geom_conaffinity.copy()
+            self._weld_ids = self._welds(physics)
+
+    def before_step(
+        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
+    ) -> list[ev.Event]:
+        physics.data.ptr.ctrl[:] = joint_targets
+        return []
+
+    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        pairs = physics.touching_pairs()
+        if len(pairs) == 0:
+            return []
+        events: list[ev.Event] = []
+        free = self._free_toy_mask()
+        if self.hand_holds is None:
+            touched = _partners(pairs, physics.hand_geom)
+            toys = np.isin(physics.toy_geoms, touched) & free
+            if physics.handle_geom in touched:
+                self.hand_holds = "stick"
+                self._weld(physics, "hand_stick")
+                events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
+            elif toys.any():
+                toy = TOYS[int(np.argmax(toys))]
+                self.hand_holds = toy
+                free[TOYS.index(toy)] = False
+                self._weld(physics, f"hand_{toy}")
+                events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
+        # A stick lying on the table catches nothing: only a stick in the hand is a tool.
+        if self.hand_holds == "stick" and self.stick_holds is None:
+            toys = np.isin(physics.toy_geoms, _partners(pairs, physics.tip_geom)) & free
+            if toys.any():
+                self.stick_holds = int(np.argmax(toys))
+                toy = TOYS[self.stick_holds]
+                self._weld(physics, f"stick_{toy}")
+                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=toy, by="stick"))
+        if events:
+            self._filter_collisions(physics)
+        return events
+
+    def _weld(self, physics: PlayroomPhysics, name: str) -> None:
+        """Activate a weld at the bodies' current relative pose.
+
+        The weld's reference pose is fixed at compile time; activating it unchanged would snap
+        the object to that pose (shared/notes.md), so the current pose of body2 in body1's
+        frame is written first.
+        """
+        m, d = physics.model.ptr, physics.data.ptr
+        eq = self._weld_ids[name]
+        b1, b2 = m.eq_obj1id[eq], m.eq_obj2id[eq]
+        rel_pos, rel_quat = np.zeros(3), np.zeros(4)
+        inv_q1 = np.zeros(4)
+        mujoco.mju_negQuat(inv_q1, d.xquat[b1])
+        mujoco.mju_rotVecQuat(rel_pos, d.xpos[b2] - d.xpos[b1], inv_q1)
+        mujoco.mju_mulQuat(rel_quat, inv_q1, d.xquat[b2])
+        m.eq_data[eq, 0:3] = 0.0
+        m.eq_data[eq, 3:6] = rel_pos
+        m.eq_data[eq, 6:10] = rel_quat
+        d.eq_active[eq] = 1
+
+    def _filter_collisions(self, physics: PlayroomPhysics) -> None:
+        """Stop each held object from colliding with what holds it, and only with that.
+
+        MuJoCo makes a contact when one geom's contype meets the other's conaffinity, so a
+        holder and its object each lose the other's bit from their conaffinity.
+        """
+        m = physics.model.ptr
+        conaff = self._base_conaffinity.copy()
+        hand, stick = physics.hand_geom, physics.stick_geoms
+        if self.hand_holds == "stick":
+            conaff[hand] &= ~STICK_BIT
+            conaff[stick] &= ~HAND_BIT
+        elif self.hand_holds in TOYS:
+            toy = physics.toy_geoms[TOYS.index(self.hand_holds)]
+            conaff[hand] &= ~TOY_BIT
+            conaff[toy] &= ~HAND_BIT
+        if self.stick_holds is not None:
+            toy = physics.toy_geoms[self.stick_holds]
+            conaff[stick] &= ~TOY_BIT
+            conaff[toy] &= ~STICK_BIT
+        m.geom_conaffinity[:] = conaff
+
+    def release(self, physics: PlayroomPhysics) -> None:
+        d = physics.data.ptr
+        for eq in self._weld_ids.values():
+            d.eq_active[eq] = 0
+        self.hand_holds = None
+        self.stick_holds = None
+        physics.model.ptr.geom_conaffinity[:] = self._base_conaffinity
+        d.qvel[physics.object_dof] = 0.0
+        _arm_to_rest(physics)
+
+
+def _partners(pairs: np.ndarray, geom: int) -> np.ndarray:
+    """Geoms in contact with `geom`, from (n, 2) contact pairs."""
+    return np.concatenate([pairs[pairs[:, 0] == geom, 1], pairs[pairs[:, 1] == geom, 0]])
+
+
+BACKENDS: dict[str, type[GraspBackend]] = {"kinematic": KinematicGrasp, "physical": PhysicalGrasp}
+
+
+def make_backend(name: str, config: WorldConfig = DEFAULT_WORLD) -> GraspBackend:
+    """The grasp backend called `name` ('kinematic' or 'physical')."""
+    if name not in BACKENDS:
+        raise ValueError(f"unknown grasp backend {name!r}: choose one of {sorted(BACKENDS)}")
+    return BACKENDS[name](config)

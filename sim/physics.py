@@ -1,0 +1,133 @@
+"""The playroom's MuJoCo physics, with measurements named for what they measure."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+
+MODEL_PATH = Path(__file__).resolve().parent.parent / "models" / "playroom.xml"
+
+TOYS = ("toy1", "toy2", "toy3")
+ARM_JOINTS = ("shoulder", "elbow", "wrist")
+OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw
+# Physics steps per control step: the model's 2 ms timestep makes a 20 ms control step, so a
+# 50-step movement lasts 1 s.
+CONTROL_SUBSTEPS = 10
+
+
+class PlayroomPhysics(dm_mujoco.Physics):
+    """Physics of the playroom. Positions are (x, y) in the table plane, in metres.
+
+    Index lookups are cached once: the named accessors of dm_control cost microseconds per
+    call, and these measurements run every control step.
+    """
+
+    @classmethod
+    def load(cls, path: str | os.PathLike = MODEL_PATH) -> PlayroomPhysics:
+        """Compile the playroom MJCF file."""
+        return cls.from_xml_path(str(path))
+
+    def _cache_indices(self) -> None:
+        m = self.model.ptr
+        self._mj_model = m
+        self._mj_data = self.data.ptr
+        site = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, n)  # noqa: E731
+        geom = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n)  # noqa: E731
+        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
+        joint = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)  # noqa: E731
+        self.hand_site = site("hand")
+        self.handle_site = site("stick_handle")
+        self.tip_site = site("stick_tip")
+        self._hand_handle_sites = np.array([self.hand_site, self.handle_site])
+        self.hand_geom = geom("hand")
+        self.handle_geom = geom("stick_handle")
+        self.tip_geom = geom("stick_tip")
+        self.stick_geoms = np.array([geom(n) for n in ("stick_handle", "stick_shaft", "stick_tip")])
+        self.toy_geoms = np.array([geom(t) for t in TOYS])
+        self.toy_bodies = np.array([body(t) for t in TOYS])
+        self.stick_body = body("stick")
+        self.hand_body = body("hand_link")
+        self.caregiver_mocap = m.body_mocapid[body("caregiver")]
+        self.caregiver_hand_mocap = m.body_mocapid[body("caregiver_hand")]
+        self.arm_qpos = np.array([m.jnt_qposadr[joint(j)] for j in ARM_JOINTS])
+        self.arm_dof = np.array([m.jnt_dofadr[joint(j)] for j in ARM_JOINTS])
+        # qpos addresses of (x, y, yaw) of each object, rows in OBJECTS order.
+        self.object_qpos = np.array(
+            [[m.jnt_qposadr[joint(f"{o}_{a}")] for a in ("x", "y", "yaw")] for o in OBJECTS]
+        )
+        self.object_dof = np.array(
+            [[m.jnt_dofadr[joint(f"{o}_{a}")] for a in ("x", "y", "yaw")] for o in OBJECTS]
+        )
+        self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
+
+    def _reload_from_data(self, data) -> None:
+        super()._reload_from_data(data)
+        self._cache_indices()
+
+    # Measurements -------------------------------------------------------------------------
+    def hand_position(self) -> np.ndarray:
+        """(2,) position of the hand site."""
+        return self._mj_data.site_xpos[self.hand_site, :2].copy()
+
+    def tracked_positions(self) -> np.ndarray:
+        """(5, 2) positions of hand, stick handle, toy1, toy2, toy3: the sensory objects."""
+        d = self._mj_data
+        out = np.empty((5, 2))
+        out[:2] = d.site_xpos[self._hand_handle_sites, :2]
+        out[2:] = d.xpos[self.toy_bodies, :2]
+        return out
+
+    def hand_angle(self) -> float:
+        """Orientation of the last segment in the plane (rad), as the protocol defines it."""
+        return float(self.arm_angles().sum() + np.pi / 2)
+
+    def arm_angles(self) -> np.ndarray:
+        """(3,) joint angles relative to rest (rad)."""
+        return self._mj_data.qpos[self.arm_qpos].copy()
+
+    def stick_handle(self) -> np.ndarray:
+        """(2,) position of the stick's handle end."""
+        return self._mj_data.site_xpos[self.handle_site, :2].copy()
+
+    def stick_tip(self) -> np.ndarray:
+        """(2,) position of the stick's far end, which catches toys."""
+        return self._mj_data.site_xpos[self.tip_site, :2].copy()
+
+    def toy_positions(self) -> np.ndarray:
+        """(3, 2) positions of toy1, toy2, toy3."""
+        return self._mj_data.xpos[self.toy_bodies, :2].copy()
+
+    def caregiver_position(self) -> np.ndarray:
+        """(2,) position of the caregiver."""
+        return self._mj_data.mocap_pos[self.caregiver_mocap, :2].copy()
+
+    def object_poses(self) -> np.ndarray:
+        """(4, 3) x, y, yaw of stick (handle), toy1, toy2, toy3, straight from the joints."""
+        return self._mj_data.qpos[self.object_qpos].copy()
+
+    def set_object_poses(self, poses: np.ndarray) -> None:
+        """Place the objects (4, 3) at rest and update the kinematics."""
+        self._mj_data.qpos[self.object_qpos] = poses
+        self._mj_data.qvel[self.object_dof] = 0.0
+        mujoco.mj_kinematics(self._mj_model, self._mj_data)
+
+    def touching_pairs(self) -> np.ndarray:
+        """(n, 2) geom ids of the pairs MuJoCo reports in contact now."""
+        d = self._mj_data
+        if d.ncon == 0:
+            return np.empty((0, 2), dtype=int)
+        return d.contact.geom[: d.ncon].copy()
+
+
+class KinematicPhysics(PlayroomPhysics):
+    """The study's kinematic world: a step only recomputes positions.
+
+    The grasp rules set joint and object positions directly (sim/grasp.py); no dynamics run.
+    """
+
+    def step(self, nstep: int = 1) -> None:
+        mujoco.mj_kinematics(self._mj_model, self._mj_data)

@@ -1,0 +1,99 @@
+"""The playroom as a dm_control task: one control step is one DMP target of a movement.
+
+The action of a step is 10 numbers: the 3 joint targets of the arm (rad, relative to rest)
+and the 7 articulators of the vocal tract (in [-1, 1]). A movement uses one of the two: the
+task is told which by `begin_movement`, and the other part of the action is ignored. The
+vocal tract is a non-physical sensor: its formants are the `sound` observation.
+"""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+from dm_control.rl import control
+from dm_env import specs
+
+from sim import events as ev
+from sim.caregiver import Caregiver
+from sim.grasp import GraspBackend
+from sim.physics import PlayroomPhysics
+
+ARM = "arm"
+VOICE = "voice"
+N_JOINTS = 3
+N_ARTICULATORS = 7
+
+
+class PlayroomTask(control.Task):
+    """Drives the arm through a grasp backend, the caregiver, and the vocal-tract sensor.
+
+    `vocal_tract` is any object with `formants(articulators) -> (2,)` giving the current
+    normalised (log2 F1 - 8.5, log2 F2 - 10.25); until one is plugged in, `sound` reads zeros.
+    """
+
+    def __init__(self, grasp: GraspBackend, caregiver: Caregiver, vocal_tract=None) -> None:
+        super().__init__()
+        self.grasp = grasp
+        self.caregiver = caregiver
+        self.vocal_tract = vocal_tract
+        self.movement: str | None = None
+        self.step_index = 0
+        self.sound = np.zeros(2)
+        self.step_events: list[ev.Event] = []
+
+    # dm_control interface -----------------------------------------------------------------
+    def initialize_episode(self, physics: PlayroomPhysics) -> None:
+        """The start of a trial: the home keyframe (arm at rest, stick at its start)."""
+        physics.reset(physics.home_key)
+        self.movement = None
+        self.sound[:] = 0.0
+
+    def action_spec(self, physics: PlayroomPhysics) -> specs.BoundedArray:
+        low = np.concatenate([np.full(N_JOINTS, -np.pi), np.full(N_ARTICULATORS, -1.0)])
+        return specs.BoundedArray(
+            (N_JOINTS + N_ARTICULATORS,), float, low, -low, name="joint_targets_articulators"
+        )
+
+    def before_step(self, action: np.ndarray, physics: PlayroomPhysics) -> None:
+        self.step_index += 1
+        self.step_events = []
+        if self.movement == ARM:
+            self.step_events += self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
+        elif self.movement == VOICE and self.vocal_tract is not None:
+            self.sound = np.asarray(self.vocal_tract.formants(action[N_JOINTS:]), dtype=float)
+        self.caregiver.before_step(physics)
+
+    def after_step(self, physics: PlayroomPhysics) -> None:
+        if self.movement == ARM:
+            self.step_events += self.grasp.after_step(physics, self.step_index)
+
+    def get_observation(self, physics: PlayroomPhysics) -> collections.OrderedDict:
+        obs = collections.OrderedDict()
+        obs["hand"] = physics.hand_position()
+        obs["stick_handle"] = physics.stick_handle()
+        obs["stick_tip"] = physics.stick_tip()
+        obs["toys"] = physics.toy_positions()
+        obs["caregiver"] = physics.caregiver_position()
+        obs["sound"] = self.sound.copy()
+        return obs
+
+    def get_reward(self, physics: PlayroomPhysics) -> float:
+        # No extrinsic reward: the learner sets its own goals (Model Babbling).
+        return 0.0
+
+    # Movements ----------------------------------------------------------------------------
+    def begin_movement(self, physics: PlayroomPhysics, movement: str) -> None:
+        if movement not in (ARM, VOICE):
+            raise ValueError(f"unknown movement {movement!r}: 'arm' or 'voice'")
+        self.movement = movement
+        self.step_index = 0
+        self.sound[:] = 0.0
+        self.grasp.begin(physics)
+
+    def end_movement(self, physics: PlayroomPhysics) -> None:
+        """Drop everything, arm to rest, the caregiver puts down what she carries."""
+        self.grasp.release(physics)
+        self.caregiver.stop(physics)
+        self.movement = None
+        self.sound[:] = 0.0

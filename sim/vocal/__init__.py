@@ -1,0 +1,13 @@
+"""The agent's voice: a DIVA-style vocal tract built on VocalTractLab (no MuJoCo in here).
+
+Modules, one concept each:
+- `config`: the study's vocal numbers (protocol.md) in `VoiceConfig`.
+- `articulators`: 7 PCA articulators in [-1, 1] -> 19 VocalTractLab tract parameters.
+- `formants`: exact formants (VTL area function + lossless-tube resonances).
+- `formant_map`: the fast fitted map articulators -> (log2 F1, log2 F2), plain NumPy.
+- `words`: vowel targets, the 6 words, their perfect trajectories, recognition.
+- `produce`: voice parameters that say each word (found by optimisation).
+- `tract`: `VocalTract`, what the world uses.
+- `audio`: waveform synthesis with VTL and WAV writing.
+- `fit_voice_model`: the script that regenerates the data files in `data/`.
+"""
