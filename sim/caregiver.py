@@ -77,7 +77,9 @@ class Caregiver:
             return
         if self.physical:
             m, d = physics.model.ptr, physics.data.ptr
-            eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"caregiver_{TOYS[self.bringing]}")
+            eq = mujoco.mj_name2id(
+                m, mujoco.mjtObj.mjOBJ_EQUALITY, f"caregiver_{TOYS[self.bringing]}"
+            )
             d.eq_active[eq] = 0
             d.qvel[physics.object_dof] = 0.0
             d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()

@@ -39,5 +39,10 @@ class Event:
     word: str | None = None
 
     def as_dict(self) -> dict:
-        return {"kind": self.kind, "step": self.step, "obj": self.obj, "by": self.by,
-                "word": self.word}
+        return {
+            "kind": self.kind,
+            "step": self.step,
+            "obj": self.obj,
+            "by": self.by,
+            "word": self.word,
+        }

@@ -86,9 +86,7 @@ class Playroom:
     def context(self) -> np.ndarray:
         """(10,) stick handle x, y; toy1 x, y; toy2 x, y; toy3 x, y; caregiver x, y."""
         p = self.physics
-        return np.concatenate(
-            [p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()]
-        )
+        return np.concatenate([p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()])
 
     # What the agent does ------------------------------------------------------------------
     def act_arm(self, m: np.ndarray) -> Feedback:
@@ -107,6 +105,38 @@ class Playroom:
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = voice_trajectory(m, self.config).T
         return self._run(VOICE, actions)
+
+    def arrange(
+        self,
+        stick: tuple[float, float, float] | None = None,
+        toys: np.ndarray | None = None,
+        caregiver: tuple[float, float] | None = None,
+    ) -> None:
+        """Put objects at chosen places, for scripted scenes.
+
+        stick: handle x, y (m) and angle (rad); toys: (3, 2) positions (m); caregiver: x, y (m).
+        Whatever is None stays where it is. The random placements go on as before afterwards.
+        """
+        checked = {
+            name: _checked_array(value, shape, name)
+            for name, value, shape in (
+                ("stick", stick, (3,)),
+                ("toys", toys, (len(TOYS), 2)),
+                ("caregiver", caregiver, (2,)),
+            )
+            if value is not None
+        }
+        p = self.physics
+        poses = p.object_poses()
+        if "stick" in checked:
+            poses[0] = checked["stick"]
+        if "toys" in checked:
+            poses[1:, :2] = checked["toys"]
+        p.set_object_poses(poses)
+        if "caregiver" in checked:
+            d = p.data.ptr
+            d.mocap_pos[[p.caregiver_mocap, p.caregiver_hand_mocap], :2] = checked["caregiver"]
+        mujoco.mj_forward(p.model.ptr, p.data.ptr)
 
     # Checkpoints --------------------------------------------------------------------------
     def get_state(self) -> dict:
@@ -161,7 +191,9 @@ class Playroom:
             events = [ev.Event(ev.DIVERGED, 0)]
         else:
             brought = self.caregiver.bringing
-            events += _movement_events(positions, events, None if brought is None else TOYS[brought])
+            events += _movement_events(
+                positions, events, None if brought is None else TOYS[brought]
+            )
             self.task.end_movement(p)
         s = self._sensory(positions[1:], sound)
         self.iteration += 1
@@ -250,16 +282,24 @@ def _movement_events(
     return moved
 
 
-def _checked_command(m, dim: int, what: str) -> np.ndarray:
-    """The command as a float array of shape (dim,), or ValueError naming what is wrong."""
+def _checked_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """`value` as a finite float array of `shape`, or ValueError naming what is wrong."""
     try:
-        arr = np.asarray(m, dtype=float)
+        arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{what} must be numbers: {exc}") from None
-    if arr.shape != (dim,):
-        raise ValueError(f"{what} must have shape ({dim},), got {arr.shape}")
+    if arr.shape != shape:
+        raise ValueError(f"{what} must have shape {shape}, got {arr.shape}")
     if not np.isfinite(arr).all():
-        raise ValueError(f"{what} contains NaN or inf at indices {np.flatnonzero(~np.isfinite(arr))}")
+        bad = np.flatnonzero(~np.isfinite(arr.ravel()))
+        raise ValueError(f"{what} contains NaN or inf at flat indices {bad.tolist()}")
+    return arr
+
+
+def _checked_command(m, dim: int, what: str) -> np.ndarray:
+    """The command as a float array of shape (dim,) in [-1, 1], or ValueError naming what is
+    wrong."""
+    arr = _checked_array(m, (dim,), what)
     if np.abs(arr).max() > 1.0 + RANGE_TOLERANCE:
         raise ValueError(f"{what} must lie in [-1, 1], max |value| is {np.abs(arr).max():.6g}")
     return np.clip(arr, -1.0, 1.0)

@@ -17,7 +17,6 @@ from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import _response_matrix, arm_trajectory
 from sim.kinematics import hand_positions
 
-
 WAYPOINT_WEIGHT = 10.0
 
 
@@ -76,7 +75,9 @@ def arm_command_through(
     weight[[w.step - 1 for w in waypoints]] = WAYPOINT_WEIGHT
     best: tuple[np.ndarray, float] | None = None
     for elbow in (1.0, -1.0):
-        q = np.array([_inverse_kinematics(p, a, elbow, config) for p, a in zip(path, angles)])
+        q = np.array(
+            [_inverse_kinematics(p, a, elbow, config) for p, a in zip(path, angles, strict=True)]
+        )
         q = np.unwrap(q, axis=0) / np.pi
         m = np.empty((3, config.arm_bfs + 1))
         for j in range(3):

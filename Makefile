@@ -1,0 +1,49 @@
+# Every job a user runs. `make run` and `make test` work on a fresh machine with only Python:
+# they create .venv and install the project into it first.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+INSTALLED := $(VENV)/.installed
+OUT ?= runs
+
+.PHONY: install run test test-slow lint format bench voice-model experiment compare video clean
+
+$(INSTALLED): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e .
+	touch $(INSTALLED)
+
+install: $(INSTALLED)
+
+## run: the project's main job with its embedded defaults
+run: $(INSTALLED)
+	$(BIN)/playroom random --grasp kinematic --iterations 40 --seed 0
+	$(BIN)/playroom random --grasp physical --iterations 40 --seed 0
+
+## test: lint, then the test suite (under 5 minutes on 2 cores)
+test: lint
+	$(BIN)/python -m pytest -q
+
+## test-slow: the longer checks marked `slow`
+test-slow: $(INSTALLED)
+	$(BIN)/python -m pytest -q -m slow
+
+lint: $(INSTALLED)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+format: $(INSTALLED)
+	$(BIN)/ruff format .
+	$(BIN)/ruff check --fix .
+
+## bench: speed figures, one `name: value unit` per line
+bench: $(INSTALLED)
+	$(BIN)/playroom bench
+
+## voice-model: regenerate the vocal tract's articulators and fitted formant map (tens of minutes)
+voice-model: $(INSTALLED)
+	$(BIN)/python -m sim.vocal.fit_voice_model
+
+clean:
+	rm -rf $(VENV) .pytest_cache .ruff_cache

@@ -1,0 +1,68 @@
+"""`playroom bench`: speed figures measured side by side in one run.
+
+Each figure is printed as `name: value unit`, one per line, so runs can be compared with diff.
+Ratios are what to compare across machines; absolute times are printed beside them.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+
+import mujoco
+import numpy as np
+
+from sim import Playroom
+from sim.config import ARM_DIM
+from sim.physics import CONTROL_SUBSTEPS
+from sim.tracking import hand_tracking_errors
+
+
+def _seconds_per_call(fn: Callable[[], object], repeats: int) -> float:
+    """Best of 3 rounds of `repeats` calls: the least disturbed by other work on the machine."""
+    best = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        for _ in range(repeats):
+            fn()
+        best = min(best, (time.perf_counter() - start) / repeats)
+    return best
+
+
+def world_figures(iterations: int = 100, seed: int = 0) -> Iterator[tuple[str, float, str]]:
+    """Cost of an arm iteration in each backend against bare mj_step calls on the same model."""
+    rng = np.random.default_rng(seed)
+    commands = rng.uniform(-1.0, 1.0, (iterations, ARM_DIM))
+    cost = {}
+    for grasp in ("physical", "kinematic"):
+        room = Playroom(grasp=grasp, seed=seed)
+        queue = iter(np.tile(commands, (3, 1)))
+        cost[grasp] = _seconds_per_call(lambda r=room, q=queue: r.act_arm(next(q)), iterations)
+    room = Playroom(grasp="physical", seed=seed)
+    m, d = room.physics.model.ptr, room.physics.data.ptr
+    n_steps = room.config.n_steps * CONTROL_SUBSTEPS
+    bare = _seconds_per_call(lambda: mujoco.mj_step(m, d, n_steps), iterations)
+    yield "physical_arm_iteration", cost["physical"] * 1e3, "ms"
+    yield f"bare_mj_step_x{n_steps}", bare * 1e3, "ms"
+    yield "physical_iteration_over_bare_mj_step", cost["physical"] / bare, "ratio (target <= 2.5)"
+    yield "kinematic_arm_iteration", cost["kinematic"] * 1e3, "ms"
+    yield "kinematic_over_physical", cost["kinematic"] / cost["physical"], "ratio"
+
+
+def tracking_figures(n_commands: int = 1000) -> Iterator[tuple[str, float, str]]:
+    errors = hand_tracking_errors(n_commands)
+    yield "hand_tracking_error_mean", errors.mean() * 1e3, f"mm over {n_commands} commands"
+    yield "hand_tracking_error_max", errors.max() * 1e3, "mm"
+
+
+SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
+    "world": world_figures,
+    "tracking": tracking_figures,
+}
+
+
+def run_bench(sections: list[str] | None = None) -> None:
+    """Print every figure of the chosen sections (all by default)."""
+    for name in sections or list(SECTIONS):
+        for figure, value, unit in SECTIONS[name]():
+            print(f"{figure}: {value:.4g} {unit}", flush=True)

@@ -1,0 +1,92 @@
+"""The `playroom` command line. Errors in what the user asked for exit with code 2 and one line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections import Counter
+
+import numpy as np
+
+
+class UsageError(Exception):
+    """A problem with what the user asked for: printed as one line, exit code 2."""
+
+
+def _non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {value}")
+    return value
+
+
+def cmd_random(args: argparse.Namespace) -> None:
+    """Random arm commands in one backend, with a summary of what happened."""
+    from sim import Playroom
+    from sim.config import ARM_DIM
+
+    room = Playroom(grasp=args.grasp, seed=args.seed)
+    rng = np.random.default_rng(args.seed)
+    counts: Counter[str] = Counter()
+    print(f"{args.iterations} random arm commands, {args.grasp} grasping, seed {args.seed}")
+    for i in range(args.iterations):
+        feedback = room.act_arm(rng.uniform(-1.0, 1.0, ARM_DIM))
+        for e in feedback.events:
+            counts[f"{e.kind}" + (f" by {e.by}" if e.by else "")] += 1
+        if feedback.events:
+            said = ", ".join(
+                f"{e.kind}({e.obj or ''}{'' if e.by in (None, 'hand', 'stick') else ' ' + e.by})"
+                f"@{e.step}"
+                for e in feedback.events
+            )
+            print(f"  iteration {i:3d}: {said}")
+    print("  totals: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
+
+
+def cmd_bench(args: argparse.Namespace) -> None:
+    from experiments.bench import SECTIONS, run_bench
+
+    unknown = [s for s in args.section if s not in SECTIONS]
+    if unknown:
+        raise UsageError(f"unknown bench section(s) {unknown}: choose from {sorted(SECTIONS)}")
+    run_bench(args.section or None)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="playroom", description="A MuJoCo playroom for Model Babbling of tool use and speech."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("random", help="act random arm commands and print what happened")
+    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--iterations", type=_positive_int, default=20)
+    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.set_defaults(func=cmd_random)
+
+    p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
+    p.add_argument("section", nargs="*", help="sections to run (default: all)")
+    p.set_defaults(func=cmd_bench)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except UsageError as exc:
+        print(f"playroom {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
