@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import mujoco
@@ -80,6 +81,9 @@ class Playroom:
         )
         self.env.reset()
         self.iteration = 0
+        # Called after every control step with (step, observation): renderers and recorders
+        # watch a movement through this without changing it.
+        self.step_observers: list[Callable[[int, dict], None]] = []
         self._place_for_iteration()
 
     # What the agent sees ------------------------------------------------------------------
@@ -181,6 +185,8 @@ class Playroom:
                 positions[k + 1, 2:] = obs["toys"]
                 sound[k] = obs["sound"]
                 events += self.task.step_events
+                for observer in self.step_observers:
+                    observer(k + 1, obs)
             if not np.isfinite(positions).all():
                 raise control.PhysicsError("non-finite positions")
         except control.PhysicsError:
