@@ -50,6 +50,30 @@ def cmd_random(args: argparse.Namespace) -> None:
     print("  totals: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
 
 
+def cmd_run(args: argparse.Namespace) -> None:
+    """One trial of Model Babbling, written to a directory that survives being killed."""
+    from experiments import storage
+    from experiments.trial import TrialError, TrialSettings, run_trial
+
+    try:
+        settings = TrialSettings(
+            grasp=args.grasp,
+            iterations=args.iterations,
+            seed=args.seed,
+            babbling=args.babbling,
+            checkpoint_every=args.checkpoint_every,
+        )
+        trial = run_trial(args.out, settings, resume=args.resume, progress=not args.quiet)
+    except (TrialError, storage.CorruptFileError) as exc:
+        raise UsageError(str(exc)) from None
+    c = trial.counts
+    print(
+        f"{args.out}: {trial.iteration} iterations ({args.grasp}, seed {args.seed}); "
+        f"tool uses {c['tool_uses']}, words recognised {c['words_recognised']}, "
+        f"diverged {c['diverged']}"
+    )
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -59,17 +83,35 @@ def cmd_bench(args: argparse.Namespace) -> None:
     run_bench(args.section or None)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse, with errors on one line (exit code 2) instead of usage plus message."""
+
+    def error(self, message: str) -> None:
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="playroom", description="A MuJoCo playroom for Model Babbling of tool use and speech."
     )
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("random", help="act random arm commands and print what happened")
     p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
     p.add_argument("--iterations", type=_positive_int, default=20)
     p.add_argument("--seed", type=_non_negative_int, default=0)
     p.set_defaults(func=cmd_random)
+
+    p = sub.add_parser("run", help="one trial of Model Babbling into a directory")
+    p.add_argument("--grasp", choices=["kinematic", "physical"], default="kinematic")
+    p.add_argument("--iterations", type=_positive_int, default=80000)
+    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.add_argument("--out", required=True, help="the trial directory")
+    p.add_argument("--babbling", choices=["random", "active"], default="random")
+    p.add_argument("--checkpoint-every", type=_positive_int, default=1000, metavar="K")
+    p.add_argument("--resume", action="store_true", help="continue the trial in --out")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
     p.add_argument("section", nargs="*", help="sections to run (default: all)")

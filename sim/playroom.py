@@ -16,6 +16,8 @@ from sim.dmp import arm_trajectory, voice_trajectory
 from sim.grasp import BACKENDS, make_backend
 from sim.physics import CONTROL_SUBSTEPS, TOYS, KinematicPhysics, PlayroomPhysics
 from sim.task import ARM, N_ARTICULATORS, N_JOINTS, VOICE, PlayroomTask
+from sim.vocal.tract import VocalTract
+from sim.vocal.words import WordAssignment, assign_words, normalise, word_features
 
 # An object counts as moved once it is this far from where it started (m). Contacts of
 # resting objects jitter by far less.
@@ -55,6 +57,8 @@ class Playroom:
 
     grasp: 'kinematic' (the study's distance rules) or 'physical' (MuJoCo contacts).
     seed: seeds every random choice of the world (placements, the caregiver's words).
+    exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
+    a frame) instead of the fitted formant map (microseconds); for audio checks.
     """
 
     def __init__(
@@ -62,7 +66,7 @@ class Playroom:
         grasp: str = "physical",
         seed: int = 0,
         config: WorldConfig = DEFAULT_WORLD,
-        vocal_tract=None,
+        exact_voice: bool = False,
     ) -> None:
         if grasp not in BACKENDS:
             raise ValueError(f"unknown grasp backend {grasp!r}: choose one of {sorted(BACKENDS)}")
@@ -72,10 +76,12 @@ class Playroom:
         self.seed = int(seed)
         self.config = config
         self.rng = np.random.default_rng(self.seed)
+        self.vocal_tract = VocalTract(exact=exact_voice)
+        self.words = assign_words(self.rng, self.vocal_tract.config)
         physics_class = KinematicPhysics if grasp == "kinematic" else PlayroomPhysics
         self.physics: PlayroomPhysics = physics_class.load()
         self.caregiver = Caregiver(physical=grasp == "physical", config=config)
-        self.task = PlayroomTask(make_backend(grasp, config), self.caregiver, vocal_tract)
+        self.task = PlayroomTask(make_backend(grasp, config), self.caregiver, self.vocal_tract)
         self.env = control.Environment(
             self.physics, self.task, n_sub_steps=CONTROL_SUBSTEPS, time_limit=float("inf")
         )
@@ -96,7 +102,8 @@ class Playroom:
     def act_arm(self, m: np.ndarray) -> Feedback:
         """Execute 21 arm parameters in [-1, 1] (protocol.md) and return the feedback.
 
-        Until a vocal tract is plugged in, the sound block s[50:60] stays at zeros.
+        Afterwards the caregiver says the name of the toy in the hand, or else a random
+        distractor: her word is the sound block s[50:60].
         """
         m = _checked_command(m, ARM_DIM, "arm command")
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
@@ -104,11 +111,39 @@ class Playroom:
         return self._run(ARM, actions)
 
     def act_voice(self, m: np.ndarray) -> Feedback:
-        """Execute 28 vocal parameters in [-1, 1] (protocol.md) and return the feedback."""
+        """Execute 28 vocal parameters in [-1, 1] (protocol.md) and return the feedback.
+
+        The sound block s[50:60] is the agent's own sound. If the caregiver recognises a toy's
+        name in it, she brings that toy toward the midpoint between her and the arm's base
+        during the same 50 steps, as in the study.
+        """
         m = _checked_command(m, VOICE_DIM, "voice command")
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = voice_trajectory(m, self.config).T
         return self._run(VOICE, actions)
+
+    def _hear(self, actions: np.ndarray) -> list[ev.Event]:
+        """The caregiver listens to the coming sound; she fetches the toy it names."""
+        # Only the 5 sample steps make the sound features (protocol.md).
+        samples = actions[list(self.config.sample_indices), N_JOINTS:]
+        features = normalise(self.vocal_tract.formants(samples), self.vocal_tract.config)
+        word = self.vocal_tract.recognise(features)
+        if word is None:
+            return []
+        toy = self.words.toy_of(word)
+        if toy is not None:
+            self.caregiver.start_bringing(self.physics, toy)
+        return [ev.Event(ev.WORD_RECOGNISED, 1, obj=None if toy is None else TOYS[toy], word=word)]
+
+    def _speak(self) -> tuple[np.ndarray, ev.Event]:
+        """After an arm movement: the name of the toy in the hand, else a random distractor."""
+        held = self.task.grasp.hand_holds
+        if held in TOYS:
+            word, obj = self.words.names[TOYS.index(held)], held
+        else:
+            word, obj = self.words.distractors[self.rng.integers(len(self.words.distractors))], None
+        features = word_features(word, config=self.vocal_tract.config)
+        return features, ev.Event(ev.CAREGIVER_SAID, self.config.n_steps, obj=obj, word=word)
 
     def arrange(
         self,
@@ -155,6 +190,7 @@ class Playroom:
             "iteration": self.iteration,
             "physics": physics_state,
             "rng": self.rng.bit_generator.state,
+            "words": [list(self.words.names), list(self.words.distractors)],
         }
 
     def set_state(self, state: dict) -> None:
@@ -166,6 +202,8 @@ class Playroom:
         mujoco.mj_forward(m, d)
         self.iteration = int(state["iteration"])
         self.rng.bit_generator.state = state["rng"]
+        names, distractors = state["words"]
+        self.words = WordAssignment(tuple(names), tuple(distractors))
 
     # The movement -------------------------------------------------------------------------
     def _run(self, movement: str, actions: np.ndarray) -> Feedback:
@@ -175,8 +213,8 @@ class Playroom:
         positions = np.empty((n + 1, len(TRACKED), 2))
         sound = np.zeros((n, 2))
         positions[0] = p.tracked_positions()
-        events: list[ev.Event] = []
         self.task.begin_movement(p, movement)
+        events = self._hear(actions) if movement == VOICE else []
         try:
             for k in range(n):
                 obs = self.env.step(actions[k]).observation
@@ -195,13 +233,18 @@ class Playroom:
             self.set_state(saved)
             positions[1:] = positions[0]
             events = [ev.Event(ev.DIVERGED, 0)]
+            said = None
         else:
             brought = self.caregiver.bringing
             events += _movement_events(
                 positions, events, None if brought is None else TOYS[brought]
             )
+            said = self._speak() if movement == ARM else None
             self.task.end_movement(p)
         s = self._sensory(positions[1:], sound)
+        if said is not None:
+            s[50:], event = said
+            events.append(event)
         self.iteration += 1
         self._place_for_iteration()
         return Feedback(movement, s, events, positions[1:], sound)

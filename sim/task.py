@@ -28,8 +28,10 @@ N_ARTICULATORS = 7
 class PlayroomTask(control.Task):
     """Drives the arm through a grasp backend, the caregiver, and the vocal-tract sensor.
 
-    `vocal_tract` is any object with `formants(articulators) -> (2,)` giving the current
-    normalised (log2 F1 - 8.5, log2 F2 - 10.25); until one is plugged in, `sound` reads zeros.
+    `vocal_tract` is the voice (sim.vocal.VocalTract): its `formants(articulators)` gives log2
+    (F1, F2) of the current articulators. The `sound` observation is those formants normalised
+    as in protocol.md (log2 F1 - 8.5, log2 F2 - 10.25) while the agent speaks, the caregiver's
+    word once she speaks, and zeros in silence.
     """
 
     def __init__(self, grasp: GraspBackend, caregiver: Caregiver, vocal_tract=None) -> None:
@@ -60,8 +62,8 @@ class PlayroomTask(control.Task):
         self.step_events = []
         if self.movement == ARM:
             self.step_events += self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
-        elif self.movement == VOICE and self.vocal_tract is not None:
-            self.sound = np.asarray(self.vocal_tract.formants(action[N_JOINTS:]), dtype=float)
+        elif self.movement == VOICE:
+            self.sound = self._normalised(self.vocal_tract.formants(action[N_JOINTS:]))
         self.caregiver.before_step(physics)
 
     def after_step(self, physics: PlayroomPhysics) -> None:
@@ -77,6 +79,10 @@ class PlayroomTask(control.Task):
         obs["caregiver"] = physics.caregiver_position()
         obs["sound"] = self.sound.copy()
         return obs
+
+    def _normalised(self, log2_formants: np.ndarray) -> np.ndarray:
+        voice = self.vocal_tract.config
+        return np.asarray(log2_formants, dtype=float) - (voice.f1_offset, voice.f2_offset)
 
     def get_reward(self, physics: PlayroomPhysics) -> float:
         # No extrinsic reward: the learner sets its own goals (Model Babbling).

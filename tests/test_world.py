@@ -150,7 +150,9 @@ def test_command_far_from_everything_moves_nothing(grasp):
     before = room.context()
     m = _command([Waypoint(20, (0.2, 0.4)), Waypoint(40, (0.32, 0.2)), Waypoint(50, (0.25, 0.3))])
     feedback = room.act_arm(m)
-    assert feedback.events == []
+    # Nothing happens but the caregiver's word after the movement: a distractor.
+    assert feedback.kinds() == [ev.CAREGIVER_SAID]
+    assert feedback.events[0].word in room.words.distractors
     # The objects' sensory blocks hold their unchanged positions.
     stick = feedback.s[10:20].reshape(2, 5)
     np.testing.assert_allclose(stick, np.repeat(before[:2, None], 5, axis=1), atol=1e-6)

@@ -122,8 +122,8 @@ def build_articulator_model(seed: int = 0, n_blends: int = N_BLENDS) -> Articula
     _, sing, vt = np.linalg.svd(corpus - mean, full_matrices=False)
     components = vt[:N_ARTICULATORS]
     # Fix each axis' sign (SVD's is arbitrary) so that a rebuild gives the same articulators.
-    components = components * np.sign(components[np.arange(N_ARTICULATORS), np.argmax(
-        np.abs(components), axis=1)])[:, None]
+    largest = components[np.arange(N_ARTICULATORS), np.argmax(np.abs(components), axis=1)]
+    components = components * np.sign(largest)[:, None]
     explained = sing[:N_ARTICULATORS] ** 2 / np.sum(sing**2)
 
     study = DEFAULT_VOICE.vowels

@@ -1,0 +1,311 @@
+"""One trial: the Model Babbling agent playing in one room, written to a directory that
+survives being killed.
+
+A trial directory holds:
+- `config.json`: every setting (trial, world, voice, learner), the package version, the seed;
+- `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
+  every `checkpoint_every` iterations and at the end;
+- `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
+  one file per checkpoint period, starting at iteration NNNNNNNN;
+- `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
+  of the 6 words.
+Each file is written atomically, and a log chunk is always written before the checkpoint that
+covers it, so a run killed at any moment resumes from its last checkpoint and rewrites the same
+chunks: the final memory and logs equal those of an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import time
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from experiments import storage
+from learner.agent import Agent
+from learner.config import LearnerConfig
+from sim import Playroom
+from sim import events as ev
+from sim.config import DEFAULT_WORLD
+from sim.physics import TOYS
+from sim.vocal.config import DEFAULT_VOICE
+from sim.vocal.words import word_distances
+
+CONFIG_FILE = "config.json"
+CHECKPOINT_FILE = "checkpoint.npz"
+LOG_DIR = "log"
+# Iterations between two rows of the words log (issue 4: "every 100 iterations").
+WORDS_LOG_PERIOD = 100
+# The agent's random generator is seeded apart from the room's, from the same trial seed.
+AGENT_STREAM = 1
+
+
+class TrialError(Exception):
+    """A trial directory or setting that cannot be used; the message says why."""
+
+
+@dataclass(frozen=True)
+class TrialSettings:
+    """What a user chooses for one trial (`playroom run`)."""
+
+    grasp: str = "kinematic"
+    iterations: int = 1000
+    seed: int = 0
+    babbling: str = "random"
+    checkpoint_every: int = 1000
+
+    def __post_init__(self) -> None:
+        if self.grasp not in ("kinematic", "physical"):
+            raise TrialError(f"unknown grasp {self.grasp!r}: 'kinematic' or 'physical'")
+        for name in ("iterations", "checkpoint_every"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+                raise TrialError(f"{name} must be a positive integer, got {value!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise TrialError(f"seed must be a non-negative integer, got {self.seed!r}")
+
+
+def full_config(settings: TrialSettings, learner: LearnerConfig | None = None) -> dict:
+    """Every setting of a trial, as written to config.json."""
+    learner = learner or LearnerConfig(babbling=settings.babbling)
+    config = {
+        "trial": dataclasses.asdict(settings),
+        "world": dataclasses.asdict(DEFAULT_WORLD),
+        "voice": dataclasses.asdict(DEFAULT_VOICE),
+        "learner": learner.to_dict(),
+        "package_version": version("playroom"),
+    }
+    # Through JSON and back, so that it compares equal to what config.json holds.
+    return json.loads(json.dumps(config))
+
+
+def _config_differences(a: dict, b: dict, prefix: str = "") -> list[str]:
+    keys = sorted(set(a) | set(b))
+    out = []
+    for k in keys:
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += _config_differences(va, vb, f"{prefix}{k}.")
+        elif va != vb:
+            out.append(f"{prefix}{k}: {va!r} != {vb!r}")
+    return out
+
+
+class Trial:
+    """A trial directory and the loop that fills it."""
+
+    def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
+        self.dir = Path(out_dir)
+        self.settings = settings
+        self.config = full_config(settings)
+        self._check_directory(resume)
+        self.room = Playroom(grasp=settings.grasp, seed=settings.seed)
+        learner_config = LearnerConfig.from_dict(self.config["learner"])
+        self.agent = Agent(learner_config, np.random.default_rng([settings.seed, AGENT_STREAM]))
+        self.iteration = 0
+        self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
+        self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
+        if resume and (self.dir / CHECKPOINT_FILE).exists():
+            self._load_checkpoint()
+
+    # Directory rules ----------------------------------------------------------------------
+    def _check_directory(self, resume: bool) -> None:
+        d = self.dir
+        if d.exists() and not d.is_dir():
+            raise TrialError(f"{d} is a file, not a directory")
+        config_path = d / CONFIG_FILE
+        if config_path.exists():
+            if not resume:
+                raise TrialError(
+                    f"{d} already holds a trial; add --resume to continue it, or choose a new "
+                    "directory"
+                )
+            diff = _config_differences(storage.read_json(config_path), self.config)
+            if diff:
+                raise TrialError(
+                    f"{d} holds a trial of another configuration ({'; '.join(diff[:4])}); "
+                    "refusing to mix them"
+                )
+        elif d.exists() and any(d.iterdir()):
+            raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
+        try:
+            (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
+            probe = d / ".write-test"
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as exc:
+            raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
+        if not config_path.exists():
+            storage.write_json(config_path, self.config)
+
+    @property
+    def finished(self) -> bool:
+        return self.iteration >= self.settings.iterations
+
+    # Checkpoints --------------------------------------------------------------------------
+    def _save_checkpoint(self) -> None:
+        agent_arrays, agent_meta = _split_state(self.agent.state_dict())
+        room_state = self.room.get_state()
+        arrays = {f"agent/{k}": v for k, v in agent_arrays.items()}
+        arrays["room/physics"] = room_state.pop("physics")
+        arrays["best_word_distance"] = self.best_word_distance
+        meta = {
+            "iteration": self.iteration,
+            "finished": self.finished,
+            "agent": agent_meta,
+            "room": room_state,
+            "counts": self.counts,
+        }
+        storage.write_arrays(self.dir / CHECKPOINT_FILE, arrays, meta)
+
+    def _load_checkpoint(self) -> None:
+        path = self.dir / CHECKPOINT_FILE
+        try:
+            arrays, meta = storage.read_arrays(path)
+            agent_state = dict(meta["agent"])
+            agent_state.update(
+                {k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")}
+            )
+            self.agent.load_state_dict(agent_state)
+            self.room.set_state({**meta["room"], "physics": arrays["room/physics"]})
+            self.best_word_distance = arrays["best_word_distance"].copy()
+        except (KeyError, ValueError, TypeError) as exc:
+            raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
+        self.iteration = int(meta["iteration"])
+        self.counts = dict(meta["counts"])
+        # Log chunks past the checkpoint belong to the lost work: they are rewritten.
+        for chunk in (self.dir / LOG_DIR).glob("*.parquet"):
+            if int(chunk.stem.split("-")[1]) >= self.iteration:
+                chunk.unlink()
+
+    # The loop -----------------------------------------------------------------------------
+    def run(self, progress: bool = True) -> None:
+        """Run until `iterations`, checkpointing every `checkpoint_every` iterations."""
+        total = self.settings.iterations
+        bar = tqdm(
+            total=total,
+            initial=self.iteration,
+            disable=not progress,
+            unit="it",
+            desc=f"{self.settings.grasp} seed {self.settings.seed}",
+            dynamic_ncols=True,
+        )
+        rows: list[dict] = []
+        word_rows: list[dict] = []
+        chunk_start = self.iteration
+        while self.iteration < total:
+            rows.append(self._iterate())
+            self.iteration += 1
+            if self.iteration % WORDS_LOG_PERIOD == 0:
+                word_rows.append(self._word_row())
+            bar.update(1)
+            if self.iteration % 50 == 0:
+                bar.set_postfix(self.counts, refresh=False)
+            if self.iteration % self.settings.checkpoint_every == 0 or self.iteration == total:
+                self._write_logs(chunk_start, rows, word_rows)
+                self._save_checkpoint()
+                rows, word_rows, chunk_start = [], [], self.iteration
+        bar.set_postfix(self.counts)
+        bar.close()
+
+    def _iterate(self) -> dict:
+        context = self.room.context()
+        proposal = self.agent.propose(context)
+        if proposal.motor_space == "arm":
+            feedback = self.room.act_arm(proposal.m)
+        else:
+            feedback = self.room.act_voice(proposal.m)
+        self.agent.learn(proposal, context, feedback.s)
+        if proposal.motor_space == "voice":
+            distances = word_distances(feedback.s[50:60], self.room.vocal_tract.config)
+            np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
+        return self._log_row(proposal, feedback)
+
+    def _log_row(self, proposal, feedback) -> dict:
+        row = {
+            "iteration": self.iteration,
+            "motor_space": proposal.motor_space,
+            "model": -1 if proposal.model is None else int(proposal.model),
+            "stick_grasped": False,
+            "stick_moved_by": "",
+            "word_recognised": "",
+            "caregiver_said": "",
+            "diverged": False,
+        }
+        for toy in TOYS:
+            row[f"{toy}_moved_by"] = ""
+        for e in feedback.events:
+            if e.kind == ev.STICK_GRASPED:
+                row["stick_grasped"] = True
+            elif e.kind == ev.STICK_MOVED:
+                row["stick_moved_by"] = e.by
+            elif e.kind == ev.TOY_MOVED:
+                row[f"{e.obj}_moved_by"] = e.by
+                self.counts["tool_uses"] += e.by == "stick"
+            elif e.kind == ev.WORD_RECOGNISED:
+                row["word_recognised"] = e.word
+                self.counts["words_recognised"] += 1
+            elif e.kind == ev.CAREGIVER_SAID:
+                row["caregiver_said"] = e.word
+            elif e.kind == ev.DIVERGED:
+                row["diverged"] = True
+                self.counts["diverged"] += 1
+        return row
+
+    def _word_row(self) -> dict:
+        row = {"iteration": self.iteration}
+        words = self.room.vocal_tract.config.words
+        for word, best in zip(words, self.best_word_distance, strict=True):
+            row[word] = float(best)
+        return row
+
+    def _write_logs(self, start: int, rows: list[dict], word_rows: list[dict]) -> None:
+        log = self.dir / LOG_DIR
+        storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
+        if word_rows:
+            storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+
+
+def _split_state(state: dict) -> tuple[dict[str, np.ndarray], dict]:
+    """Arrays go to the .npz file, everything else (numbers, generator states) to JSON."""
+    arrays = {k: v for k, v in state.items() if isinstance(v, np.ndarray)}
+    meta = {k: _jsonable(v) for k, v in state.items() if not isinstance(v, np.ndarray)}
+    return arrays, meta
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:
+    """All chunks of one log ('iterations' or 'words') of a trial, in order."""
+    chunks = sorted((Path(trial_dir) / LOG_DIR).glob(f"{kind}-*.parquet"))
+    if not chunks:
+        return pd.DataFrame()
+    return pd.concat([storage.read_table(c) for c in chunks], ignore_index=True)
+
+
+def run_trial(
+    out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False, progress=True
+) -> Trial:
+    """Create (or resume) a trial in out_dir and run it to the end."""
+    trial = Trial(out_dir, settings, resume=resume)
+    if trial.finished:
+        return trial
+    start = time.perf_counter()
+    trial.run(progress=progress)
+    trial.elapsed = time.perf_counter() - start
+    return trial

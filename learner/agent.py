@@ -1,0 +1,251 @@
+"""The Model Babbling agent (protocol.md, "Learning"): bootstrap, goals, imitation, learning.
+
+One iteration is `proposal = agent.propose(context)`, the world executes `proposal.m` with the
+arm or the voice, then `agent.learn(proposal, context, s)` with the feedback s (60,).
+
+- Bootstrap: the first `bootstrap_arm + bootstrap_voice` proposals are uniformly random
+  commands, their motor spaces in a shuffled order drawn at construction.
+- Then: choose a model (learner.interest), a goal uniform in [goal_low, goal_high]^10 of its
+  sensory space (for model 10, with probability `imitation_share`, a caregiver sound heard
+  after one of the last `imitation_memory` arm movements instead), take the inverse model's
+  command and add Gaussian noise of `exploration_sigma`, clipped to the motor bounds. A model
+  with no experience yet proposes a uniformly random command (`inferred` is then False).
+- Learning: every model of the motor space used applies the storing rule (cross-learning);
+  the chosen model's interest records its competence; after an arm movement the sound block
+  is recorded as a heard caregiver sound.
+
+All randomness comes from the agent's own numpy Generator, which `state_dict` saves, so an
+agent restored from a checkpoint continues bit-identically.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from learner.config import LearnerConfig
+from learner.interest import InterestModel
+from learner.sensorimotor_model import MODELS, ModelSpec, SensorimotorModel, block_slice
+
+_SPACE_CODE = {"arm": 0, "voice": 1}  # bootstrap order is stored as these codes
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """What the agent wants to do this iteration."""
+
+    motor_space: str  # "arm" or "voice"
+    m: np.ndarray  # (21,) or (28,), in [motor_low, motor_high]
+    model: int | None  # 0-based index into the model table; None during bootstrap
+    goal: np.ndarray | None  # (10,) sensory goal of that model; None during bootstrap
+    kind: str  # "bootstrap", "goal" (self-generated) or "imitation" (a caregiver sound)
+    inferred: bool  # False when m is random (bootstrap, or a model with no experience yet)
+
+
+class Agent:
+    """Model Babbling over the models of `models` (default: the study's 10)."""
+
+    def __init__(
+        self,
+        config: LearnerConfig | None = None,
+        rng: np.random.Generator | int | None = None,
+        models: tuple[ModelSpec, ...] = MODELS,
+    ) -> None:
+        self.config = config if config is not None else LearnerConfig()
+        self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        self.specs = tuple(models)
+        self.models = [SensorimotorModel(spec, self.config) for spec in self.specs]
+        self._by_space = {
+            space: [k for k, spec in enumerate(self.specs) if spec.motor_space == space]
+            for space in _SPACE_CODE
+        }
+        self.interest = InterestModel(len(self.specs), self.config)
+        cfg = self.config
+        order = np.repeat(np.array([0, 1], dtype=np.int8), [cfg.bootstrap_arm, cfg.bootstrap_voice])
+        self._bootstrap_order = self.rng.permutation(order)
+        self.t = 0  # iterations learnt
+        # Ring buffer of the sounds heard after the last `imitation_memory` arm movements.
+        self._heard = np.zeros((cfg.imitation_memory, cfg.block_dim))
+        self._n_heard = 0
+        self._sound_slice = block_slice("sound", cfg.block_dim)
+        self._pending: Proposal | None = None
+
+    # ------------------------------------------------------------------ the learning loop
+
+    def propose(self, context: ArrayLike) -> Proposal:
+        """The command to execute in `context` (10,)."""
+        context = self._check_context(context)
+        cfg = self.config
+        if self.t < cfg.n_bootstrap:
+            space = "arm" if self._bootstrap_order[self.t] == 0 else "voice"
+            m = self.rng.uniform(cfg.motor_low, cfg.motor_high, cfg.motor_dim(space))
+            proposal = Proposal(space, m, None, None, "bootstrap", False)
+        else:
+            k = self.interest.choose(self.rng)
+            spec, model = self.specs[k], self.models[k]
+            kind = "goal"
+            if (
+                spec.imitates_caregiver
+                and self._n_heard > 0
+                and self.rng.random() < cfg.imitation_share
+            ):
+                goal, kind = self._imitation_goal(), "imitation"
+            else:
+                goal = self.rng.uniform(cfg.goal_low, cfg.goal_high, model.sensory_dim)
+            if len(model) == 0:
+                m = self.rng.uniform(cfg.motor_low, cfg.motor_high, model.motor_dim)
+                inferred = False
+            else:
+                m, _ = model.inverse(context, goal)
+                m += self.rng.normal(0.0, cfg.exploration_sigma, model.motor_dim)
+                np.clip(m, cfg.motor_low, cfg.motor_high, out=m)
+                inferred = True
+            proposal = Proposal(spec.motor_space, m, k, goal, kind, inferred)
+        self._pending = proposal
+        return proposal
+
+    def learn(self, proposal: Proposal, context: ArrayLike, s: ArrayLike) -> None:
+        """Learn from the feedback s (60,) of `proposal`, executed in `context` (10,)."""
+        if proposal is not self._pending:
+            raise ValueError("learn() takes the proposal returned by the last propose()")
+        context = self._check_context(context)
+        s = np.asarray(s, dtype=np.float64)
+        if s.shape != (self.config.sensory_dim,):
+            raise ValueError(
+                f"feedback s must have shape ({self.config.sensory_dim},), got {s.shape}"
+            )
+        if not np.isfinite(s).all():
+            raise ValueError("feedback s has a NaN or infinite value")
+        m = proposal.m
+        for k in self._by_space[proposal.motor_space]:
+            self.models[k].update(m, context, s)
+        if proposal.model is not None:
+            reached = s[self.models[proposal.model].sensory_slice]
+            self.interest.update(proposal.model, proposal.goal, reached)
+        if proposal.motor_space == "arm":
+            sound = s[self._sound_slice]
+            if np.any(np.abs(sound) > self.config.change_tolerance):  # she spoke
+                self._heard[self._n_heard % len(self._heard)] = sound
+                self._n_heard += 1
+        self.t += 1
+        self._pending = None
+
+    # ------------------------------------------------------------------ evaluation
+
+    def toy_models(self, toy: int) -> tuple[int, int]:
+        """0-based indices of the arm model and the voice model of toy 1, 2 or 3."""
+        block = f"toy{toy}"
+        found = {
+            spec.motor_space: k for k, spec in enumerate(self.specs) if spec.sensory_block == block
+        }
+        if set(found) != {"arm", "voice"}:
+            raise ValueError(f"no arm and voice models for toy {toy!r}")
+        return found["arm"], found["voice"]
+
+    def nearest_distance(self, model: int, context: ArrayLike, goal: ArrayLike) -> float:
+        """Distance from (c_i, goal) to model's nearest experience (inf if it has none)."""
+        return self.models[model].nearest_distance(self._check_context(context), goal)
+
+    def exploit(self, model: int, context: ArrayLike, goal: ArrayLike) -> np.ndarray:
+        """The inverse model's command for goal (10,) in context (10,), without noise.
+
+        A model with no experience raises ValueError. Draws nothing from the agent's rng.
+        """
+        m, _ = self.models[model].inverse(self._check_context(context), goal)
+        return m
+
+    @property
+    def heard_sounds(self) -> np.ndarray:
+        """The caregiver sounds imitation draws from (k, 10), oldest first, k <= 100."""
+        size = len(self._heard)
+        if self._n_heard <= size:
+            return self._heard[: self._n_heard].copy()
+        start = self._n_heard % size
+        return np.concatenate((self._heard[start:], self._heard[:start]))
+
+    # ------------------------------------------------------------------ checkpoints
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Everything to continue bit-identically: plain arrays and 0-d arrays, for np.savez.
+
+        Keys: 'config' and 'rng' (JSON strings), 't', 'bootstrap_order', 'heard', 'n_heard',
+        'interest.*', and 'model{number}.motor' / 'model{number}.key' per model.
+        """
+        state: dict[str, np.ndarray] = {
+            "config": np.array(self.config.to_json()),
+            "models": np.array([spec.number for spec in self.specs]),
+            "rng": np.array(json.dumps(_jsonable(self.rng.bit_generator.state))),
+            "t": np.array(self.t, dtype=np.int64),
+            "bootstrap_order": self._bootstrap_order.copy(),
+            "heard": self._heard.copy(),
+            "n_heard": np.array(self._n_heard, dtype=np.int64),
+        }
+        for key, value in self.interest.state_dict().items():
+            state[f"interest.{key}"] = value
+        for spec, model in zip(self.specs, self.models, strict=True):
+            for key, value in model.state_dict().items():
+                state[f"model{spec.number}.{key}"] = value
+        return state
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore a `state_dict()` (also as loaded by np.load). The config must match."""
+        saved = json.loads(str(np.asarray(state["config"])))
+        if saved != self.config.to_dict():
+            diff = sorted(k for k in saved if saved.get(k) != self.config.to_dict().get(k))
+            raise ValueError(f"checkpoint was made with another learner config: {diff}")
+        numbers = [int(n) for n in np.asarray(state["models"])]
+        if numbers != [spec.number for spec in self.specs]:
+            raise ValueError(f"checkpoint has models {numbers}, this agent has other models")
+        order = np.asarray(state["bootstrap_order"], dtype=np.int8)
+        if order.shape != self._bootstrap_order.shape:
+            raise ValueError(f"checkpoint bootstrap order has shape {order.shape}")
+        heard = np.asarray(state["heard"], dtype=np.float64)
+        if heard.shape != self._heard.shape:
+            raise ValueError(f"checkpoint heard sounds have shape {heard.shape}")
+        for spec, model in zip(self.specs, self.models, strict=True):
+            prefix = f"model{spec.number}."
+            model.load_state_dict(
+                {k[len(prefix) :]: v for k, v in state.items() if k.startswith(prefix)}
+            )
+        self.interest.load_state_dict(
+            {k[len("interest.") :]: v for k, v in state.items() if k.startswith("interest.")}
+        )
+        self.rng.bit_generator.state = json.loads(str(np.asarray(state["rng"])))
+        self.t = int(state["t"])
+        self._bootstrap_order = order.copy()
+        self._heard = heard.copy()
+        self._n_heard = int(state["n_heard"])
+        self._pending = None
+
+    # ------------------------------------------------------------------ helpers
+
+    def _imitation_goal(self) -> np.ndarray:
+        sounds = self.heard_sounds
+        if self.config.imitation_draw == "distinct":
+            sounds = np.unique(sounds, axis=0)  # sorted: the draw does not depend on order
+        return sounds[self.rng.integers(len(sounds))].copy()
+
+    def _check_context(self, context: ArrayLike) -> np.ndarray:
+        context = np.asarray(context, dtype=np.float64)
+        if context.shape != (self.config.context_dim,):
+            raise ValueError(
+                f"context must have shape ({self.config.context_dim},), got {context.shape}"
+            )
+        if not np.isfinite(context).all():
+            raise ValueError("context has a NaN or infinite value")
+        return context
+
+
+def _jsonable(value: Any) -> Any:
+    """The bit generator's state with numpy scalars and arrays made JSON-friendly."""
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.integer):
+        return int(value)
+    return value

@@ -1,0 +1,145 @@
+"""Every learning number of the study (protocol.md, "Learning (Model Babbling)"), in one place.
+
+The learner sees vectors only, so its units are those of the vectors: motor commands and
+sensory goals live in [-1, 1]; positions in the sensory feedback are in the paper's length
+units (metres in the MJCF model); sounds are in normalised log2-Hz (protocol.md, "Sensory
+feedback"). The 10 sensorimotor models (which motor space, context and sensory dimensions each
+uses) are the table `learner.sensorimotor_model.MODELS`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from typing import Any
+
+BABBLING_MODES = ("random", "active")
+IMITATION_DRAWS = ("distinct", "heard")
+
+
+@dataclass(frozen=True)
+class LearnerConfig:
+    # Motor spaces (protocol.md, "One iteration"): parameters in [motor_low, motor_high].
+    arm_dim: int = 21  # 3 joints x (6 DMP weights + 1 end position)
+    voice_dim: int = 28  # 7 articulators x (start, end, 2 DMP weights)
+    motor_low: float = -1.0
+    motor_high: float = 1.0
+    # What the world shows the learner (protocol.md, "One iteration" and "Sensory feedback").
+    context_dim: int = 10  # stick handle, toy1, toy2, toy3, caregiver: x, y each
+    sensory_dim: int = 60  # hand, stick, toy1, toy2, toy3, sound: 10 values each
+    samples_per_block: int = 5  # a 10D block is 5 x samples then 5 y samples (or F1, F2)
+    # Bootstrap (protocol.md): random commands before any goal babbling, in shuffled order.
+    bootstrap_arm: int = 500  # commands
+    bootstrap_voice: int = 500  # commands
+    # Goal babbling: goals are drawn uniformly in [goal_low, goal_high]^10 of a sensory space.
+    goal_low: float = -1.0
+    goal_high: float = 1.0
+    # Exploration noise added to the inverse model's command, in motor units. The paper says
+    # 0.05; the study's public implementation used 0.1.
+    exploration_sigma: float = 0.05
+    # Model choice: "random" (the paper) or "active" (learning progress, public implementation).
+    babbling: str = "random"
+    active_random_share: float = 0.2  # share of uniformly random choices in "active" mode
+    # Attempts per half-window of the progress measure (learner.interest). Not a number of the
+    # protocol: the public implementation smoothed progress over about 1000 attempts instead.
+    progress_window: int = 100  # attempts of one model
+    # Imitation by model 10 (protocol.md, "Learning"): share of its goals that are caregiver
+    # sounds, drawn from the last `imitation_memory` sounds heard after arm movements.
+    imitation_share: float = 0.5
+    imitation_memory: int = 100  # sounds
+    # "distinct": uniform over the distinct sounds of that window (the public implementation);
+    # "heard": uniform over the window's entries, so frequent words are imitated more.
+    imitation_draw: str = "distinct"
+    # Storing rule: a sensory block "changed" when a value differs from its reference by more
+    # than this (metres for positions, normalised log2-Hz for sounds). It absorbs the jitter of
+    # resting objects in the physical backend; real movements are centimetres.
+    change_tolerance: float = 1e-3
+
+    def __post_init__(self) -> None:
+        positive_ints = (
+            "arm_dim",
+            "voice_dim",
+            "context_dim",
+            "sensory_dim",
+            "samples_per_block",
+            "progress_window",
+            "imitation_memory",
+        )
+        for name in positive_ints:
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value <= 0:
+                raise ValueError(f"LearnerConfig.{name} must be a positive integer, got {value!r}")
+        for name in ("bootstrap_arm", "bootstrap_voice"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+                raise ValueError(
+                    f"LearnerConfig.{name} must be a non-negative integer, got {value!r}"
+                )
+        for low, high in (("motor_low", "motor_high"), ("goal_low", "goal_high")):
+            lo, hi = getattr(self, low), getattr(self, high)
+            if not (_finite(lo) and _finite(hi) and lo < hi):
+                raise ValueError(
+                    f"LearnerConfig.{low} < {high} must be finite with {low} < {high}, "
+                    f"got {lo!r}, {hi!r}"
+                )
+        for name in ("exploration_sigma", "change_tolerance"):
+            value = getattr(self, name)
+            if not (_finite(value) and value >= 0):
+                raise ValueError(f"LearnerConfig.{name} must be finite and >= 0, got {value!r}")
+        for name in ("active_random_share", "imitation_share"):
+            value = getattr(self, name)
+            if not (_finite(value) and 0.0 <= value <= 1.0):
+                raise ValueError(f"LearnerConfig.{name} must be in [0, 1], got {value!r}")
+        if self.babbling not in BABBLING_MODES:
+            raise ValueError(
+                f"LearnerConfig.babbling must be one of {BABBLING_MODES}, got {self.babbling!r}"
+            )
+        if self.imitation_draw not in IMITATION_DRAWS:
+            raise ValueError(
+                f"LearnerConfig.imitation_draw must be one of {IMITATION_DRAWS}, "
+                f"got {self.imitation_draw!r}"
+            )
+        if self.sensory_dim % (2 * self.samples_per_block) != 0:
+            raise ValueError(
+                f"LearnerConfig.sensory_dim ({self.sensory_dim}) must be a whole number of "
+                f"blocks of 2 * samples_per_block ({2 * self.samples_per_block})"
+            )
+
+    @property
+    def block_dim(self) -> int:
+        """Values in one sensory block (10): x then y samples, or F1 then F2."""
+        return 2 * self.samples_per_block
+
+    @property
+    def n_bootstrap(self) -> int:
+        return self.bootstrap_arm + self.bootstrap_voice
+
+    def motor_dim(self, motor_space: str) -> int:
+        if motor_space == "arm":
+            return self.arm_dim
+        if motor_space == "voice":
+            return self.voice_dim
+        raise ValueError(f"unknown motor space {motor_space!r}: expected 'arm' or 'voice'")
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any]) -> LearnerConfig:
+        """Build from `to_dict()` output; unknown keys raise ValueError naming them."""
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ValueError(f"unknown LearnerConfig fields: {', '.join(unknown)}")
+        return cls(**values)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and abs(value) < 1e308
+
+
+DEFAULT_LEARNER = LearnerConfig()

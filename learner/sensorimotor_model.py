@@ -1,0 +1,259 @@
+"""Sensorimotor models: one arrow of the paper's Fig. 2, motor space -> sensory block | context.
+
+A model keeps the experiences (m, c_i, s_i) of its motor space whose sensory block changed,
+and answers, by nearest neighbour (protocol.md, "Learning"):
+- inverse: the motor command m of the stored (c_i, s_i) nearest to (context, goal);
+- forward: the sensory block s_i of the stored (m, c_i) nearest to (command, context).
+
+Storing rule (protocol.md: "only when its sensory part changed during the movement"):
+- a block with a start position in the context (stick handle, toy i) changed when one of its
+  5 x, 5 y samples is more than `change_tolerance` from that start position. The context is
+  the position before the movement, so a toy grabbed before the first sample (step 1 of 50)
+  still counts as moved, which comparing the samples with each other would miss;
+- the hand block has no start in the context: it changed when a sample differs from the first
+  sample. Its start is always the rest position, reached again only by a still arm;
+- the sound block changed when a sound was heard or produced: one value is more than the
+  tolerance away from 0, the silent block the world sends. After an arm movement the caregiver
+  always speaks, so model 6 stores every arm movement.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from learner.config import LearnerConfig
+from learner.memory import NearestNeighbourMemory
+
+# Layout of the world's vectors (protocol.md, "One iteration" and "Sensory feedback").
+CONTEXT_SLOTS: dict[str, tuple[int, int]] = {
+    "stick": (0, 1),  # handle x, y
+    "toy1": (2, 3),
+    "toy2": (4, 5),
+    "toy3": (6, 7),
+    "caregiver": (8, 9),
+}
+SENSORY_BLOCKS: tuple[str, ...] = ("hand", "stick", "toy1", "toy2", "toy3", "sound")
+MOTOR_SPACES: tuple[str, ...] = ("arm", "voice")
+_INITIAL_CAPACITY = 1024  # rows preallocated per model, doubled when full
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """One sensorimotor model: motor space -> sensory block | context slots."""
+
+    number: int  # 1..10, as in protocol.md
+    motor_space: str  # "arm" or "voice"
+    sensory_block: str  # one of SENSORY_BLOCKS
+    context_slots: tuple[str, ...]  # keys of CONTEXT_SLOTS, in this order in c_i
+    imitates_caregiver: bool = False  # draws some goals from heard caregiver sounds
+
+    @property
+    def name(self) -> str:
+        context = ", ".join(self.context_slots) or "none"
+        return f"{self.motor_space} -> {self.sensory_block} | {context}"
+
+    @property
+    def context_dims(self) -> tuple[int, ...]:
+        """Indices into the context c (10,) of this model's context c_i."""
+        return tuple(i for slot in self.context_slots for i in CONTEXT_SLOTS[slot])
+
+    def sensory_slice(self, block_dim: int) -> slice:
+        """Slice of the feedback s (60,) holding this model's sensory block s_i."""
+        return block_slice(self.sensory_block, block_dim)
+
+
+def block_slice(block: str, block_dim: int) -> slice:
+    """Slice of the feedback s (60,) holding the named block of SENSORY_BLOCKS."""
+    k = SENSORY_BLOCKS.index(block)
+    return slice(k * block_dim, (k + 1) * block_dim)
+
+
+# The 10 models of protocol.md, "The 10 sensorimotor models".
+MODELS: tuple[ModelSpec, ...] = (
+    ModelSpec(1, "arm", "hand", ()),
+    ModelSpec(2, "arm", "stick", ("stick",)),
+    ModelSpec(3, "arm", "toy1", ("stick", "toy1")),
+    ModelSpec(4, "arm", "toy2", ("stick", "toy2")),
+    ModelSpec(5, "arm", "toy3", ("stick", "toy3")),
+    ModelSpec(6, "arm", "sound", ("stick", "toy1", "toy2", "toy3")),
+    ModelSpec(7, "voice", "toy1", ("toy1", "caregiver")),
+    ModelSpec(8, "voice", "toy2", ("toy2", "caregiver")),
+    ModelSpec(9, "voice", "toy3", ("toy3", "caregiver")),
+    ModelSpec(10, "voice", "sound", (), imitates_caregiver=True),
+)
+
+
+class SensorimotorModel:
+    """The experiences of one ModelSpec, with nearest-neighbour inverse and forward models."""
+
+    def __init__(self, spec: ModelSpec, config: LearnerConfig) -> None:
+        if spec.motor_space not in MOTOR_SPACES:
+            raise ValueError(f"model {spec.number}: unknown motor space {spec.motor_space!r}")
+        if spec.sensory_block not in SENSORY_BLOCKS:
+            raise ValueError(f"model {spec.number}: unknown sensory block {spec.sensory_block!r}")
+        unknown = [slot for slot in spec.context_slots if slot not in CONTEXT_SLOTS]
+        if unknown:
+            raise ValueError(f"model {spec.number}: unknown context slots {unknown}")
+        self.spec = spec
+        self.motor_dim = config.motor_dim(spec.motor_space)
+        self.context_dims = np.array(spec.context_dims, dtype=np.intp)
+        self.sensory_slice = spec.sensory_slice(config.block_dim)
+        self.sensory_dim = config.block_dim
+        self._samples = config.samples_per_block
+        self._tolerance = config.change_tolerance
+        # Where the block's object was before the movement, if the context says it.
+        start = CONTEXT_SLOTS.get(spec.sensory_block)
+        self._start_dims = None if start is None else np.array(start, dtype=np.intp)
+        c_dim = len(self.context_dims)
+        self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
+        self._n = 0
+        self._inverse = NearestNeighbourMemory(c_dim + self.sensory_dim)  # rows (c_i, s_i)
+        self._forward: NearestNeighbourMemory | None = None  # rows (m, c_i), built on demand
+
+    def __len__(self) -> int:
+        return self._n
+
+    @property
+    def motor(self) -> np.ndarray:
+        """Stored motor commands (n, motor_dim), read-only view."""
+        view = self._motor[: self._n]
+        view.flags.writeable = False
+        return view
+
+    @property
+    def context(self) -> np.ndarray:
+        """Stored contexts c_i (n, len(context_dims)), read-only view."""
+        return self._inverse.rows[:, : len(self.context_dims)]
+
+    @property
+    def sensory(self) -> np.ndarray:
+        """Stored sensory blocks s_i (n, 10), read-only view."""
+        return self._inverse.rows[:, len(self.context_dims) :]
+
+    def sensory_changed(self, context: np.ndarray, s: np.ndarray) -> bool:
+        """The storing rule (module docstring), for a full context (10,) and feedback (60,)."""
+        block = s[self.sensory_slice]
+        if self.spec.sensory_block == "sound":
+            return bool(np.any(np.abs(block) > self._tolerance))
+        xy = block.reshape(2, self._samples)  # row 0: x samples, row 1: y samples
+        if self._start_dims is not None:
+            start = context[self._start_dims][:, None]
+        else:
+            start = xy[:, :1]
+        return bool(np.any(np.abs(xy - start) > self._tolerance))
+
+    def update(self, m: np.ndarray, context: np.ndarray, s: np.ndarray) -> bool:
+        """Store (m, c_i, s_i) if the sensory block changed; return whether it was stored.
+
+        m (motor_dim,), context (10,), s (60,): the caller has checked shapes.
+        """
+        if not self.sensory_changed(context, s):
+            return False
+        c_i = context[self.context_dims]
+        self._inverse.append(np.concatenate((c_i, s[self.sensory_slice])))
+        self._append_motor(m[None, :])
+        if self._forward is not None:
+            self._forward.append(np.concatenate((m, c_i)))
+        return True
+
+    def extend(self, motor: ArrayLike, context: ArrayLike, sensory: ArrayLike) -> None:
+        """Store k experiences at once, without the storing rule (loading, benchmarks).
+
+        motor (k, motor_dim), context (k, len(context_dims)) already reduced to c_i,
+        sensory (k, 10) already reduced to s_i.
+        """
+        motor = np.asarray(motor, dtype=np.float64)
+        context = np.asarray(context, dtype=np.float64).reshape(len(motor), -1)
+        sensory = np.asarray(sensory, dtype=np.float64)
+        if motor.ndim != 2 or motor.shape[1] != self.motor_dim:
+            raise ValueError(f"motor rows must have shape (k, {self.motor_dim}), got {motor.shape}")
+        if context.shape[1] != len(self.context_dims) or sensory.shape != (
+            len(motor),
+            self.sensory_dim,
+        ):
+            raise ValueError(
+                f"model {self.spec.number}: context (k, {len(self.context_dims)}) and sensory "
+                f"(k, {self.sensory_dim}) rows expected, got {context.shape}, {sensory.shape}"
+            )
+        if not np.isfinite(motor).all():
+            raise ValueError("motor rows have a NaN or infinite value")
+        self._inverse.extend(np.hstack((context, sensory)))
+        self._append_motor(motor)
+        if self._forward is not None:
+            self._forward.extend(np.hstack((motor, context)))
+
+    def inverse(self, context: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, float]:
+        """(motor command (motor_dim,) of the stored (c_i, s_i) nearest to (c_i, goal), distance).
+
+        context (10,) full context, goal (10,). Raises ValueError if the model is empty.
+        """
+        i, distance = self._nearest_inverse(context, goal)
+        return self._motor[i].copy(), distance
+
+    def nearest_distance(self, context: np.ndarray, goal: np.ndarray) -> float:
+        """Euclidean distance from (c_i, goal) to the nearest stored (c_i, s_i); inf if empty."""
+        if self._n == 0:
+            return float("inf")
+        return self._nearest_inverse(context, goal)[1]
+
+    def forward(self, m: np.ndarray, context: np.ndarray) -> np.ndarray:
+        """Predicted sensory block (10,): s_i of the stored (m, c_i) nearest to (m, c_i)."""
+        if self._n == 0:
+            raise ValueError(f"model {self.spec.number} has no experience to predict from")
+        m = np.asarray(m, dtype=np.float64)
+        if m.shape != (self.motor_dim,):
+            raise ValueError(f"motor command must have shape ({self.motor_dim},), got {m.shape}")
+        if self._forward is None:
+            # Built on the first forward question only: the learning loop never asks one.
+            self._forward = NearestNeighbourMemory(self.motor_dim + len(self.context_dims))
+            self._forward.extend(np.hstack((self.motor, self.context)))
+        c_i = np.asarray(context, dtype=np.float64)[self.context_dims]
+        i, _ = self._forward.nearest(np.concatenate((m, c_i)))
+        return self.sensory[i].copy()
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """{'motor': (n, motor_dim), 'key': (n, c_dim + 10)}: plain float64 arrays."""
+        return {"motor": self._motor[: self._n].copy(), "key": self._inverse.state_dict()["rows"]}
+
+    def load_state_dict(self, state: dict[str, np.ndarray]) -> None:
+        motor = np.asarray(state["motor"], dtype=np.float64)
+        key = np.asarray(state["key"], dtype=np.float64)
+        if motor.ndim != 2 or motor.shape[1] != self.motor_dim or key.shape[0] != len(motor):
+            raise ValueError(
+                f"model {self.spec.number}: state of {motor.shape} motor rows and {key.shape} "
+                f"keys does not fit motor dimension {self.motor_dim}"
+            )
+        self._inverse.load_state_dict({"rows": key})
+        self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
+        self._n = 0
+        self._append_motor(motor)
+        self._forward = None
+
+    def nbytes(self) -> int:
+        """Bytes held by this model's arrays."""
+        forward = 0 if self._forward is None else self._forward.nbytes()
+        return self._motor.nbytes + self._inverse.nbytes() + forward
+
+    def _nearest_inverse(self, context: np.ndarray, goal: np.ndarray) -> tuple[int, float]:
+        if self._n == 0:
+            raise ValueError(f"model {self.spec.number} has no experience to invert")
+        goal = np.asarray(goal, dtype=np.float64)
+        if goal.shape != (self.sensory_dim,):
+            raise ValueError(f"goal must have shape ({self.sensory_dim},), got {goal.shape}")
+        c_i = np.asarray(context, dtype=np.float64)[self.context_dims]
+        return self._inverse.nearest(np.concatenate((c_i, goal)))
+
+    def _append_motor(self, motor: np.ndarray) -> None:
+        k = len(motor)
+        if self._n + k > len(self._motor):
+            capacity = max(len(self._motor), _INITIAL_CAPACITY)
+            while capacity < self._n + k:  # doubling, as the memories grow
+                capacity *= 2
+            grown = np.empty((capacity, self.motor_dim))
+            grown[: self._n] = self._motor[: self._n]
+            self._motor = grown
+        self._motor[self._n : self._n + k] = motor
+        self._n += k

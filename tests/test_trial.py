@@ -1,0 +1,174 @@
+"""One trial (`playroom run`): learning, checkpoints, kill and resume, bad input."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from experiments import storage
+from experiments.cli import main
+from experiments.trial import CHECKPOINT_FILE, TrialSettings, read_log, run_trial
+from learner.agent import Agent
+from learner.config import LearnerConfig
+from sim import Playroom
+from sim.config import DEFAULT_WORLD
+from sim.dmp import arm_trajectory
+from sim.kinematics import hand_positions
+
+PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+
+
+def _run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*PLAYROOM, *args], capture_output=True, text=True, cwd=Path(__file__).parent.parent
+    )
+
+
+def _arrays_equal(a: dict, b: dict) -> None:
+    assert sorted(a) == sorted(b)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_run_writes_config_checkpoint_and_logs(tmp_path, grasp):
+    out = tmp_path / "trial"
+    trial = run_trial(
+        out, TrialSettings(grasp=grasp, iterations=120, seed=1, checkpoint_every=50), progress=False
+    )
+    assert trial.iteration == 120
+    config = storage.read_json(out / "config.json")
+    assert config["trial"]["seed"] == 1 and config["trial"]["grasp"] == grasp
+    assert "package_version" in config and config["learner"]["exploration_sigma"] == 0.05
+    log = read_log(out)
+    assert list(log["iteration"]) == list(range(120))
+    assert set(log["motor_space"]) <= {"arm", "voice"}
+    words = read_log(out, "words")
+    assert list(words["iteration"]) == [100]
+    arrays, meta = storage.read_arrays(out / CHECKPOINT_FILE)
+    assert meta["iteration"] == 120 and meta["finished"]
+
+
+def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path):
+    args = ["run", "--grasp", "kinematic", "--iterations", "1500", "--seed", "4"]
+    args += ["--checkpoint-every", "200", "--quiet"]
+    whole = tmp_path / "whole"
+    assert _run_cli(*args, "--out", str(whole)).returncode == 0
+
+    killed = tmp_path / "killed"
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen(
+        [*PLAYROOM, *args, "--out", str(killed)], cwd=Path(__file__).parent.parent, env=env
+    )
+    # Kill at a random moment after the first checkpoint exists.
+    deadline = time.monotonic() + 120
+    while not (killed / CHECKPOINT_FILE).exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(np.random.default_rng().uniform(0.0, 1.5))
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    resumed = _run_cli(*args, "--out", str(killed), "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+
+    a, meta_a = storage.read_arrays(whole / CHECKPOINT_FILE)
+    b, meta_b = storage.read_arrays(killed / CHECKPOINT_FILE)
+    _arrays_equal(a, b)
+    assert meta_a == meta_b
+    for kind in ("iterations", "words"):
+        assert read_log(whole, kind).equals(read_log(killed, kind))
+
+
+def test_a_3000_iteration_run_learns_to_reach_hand_goals(tmp_path):
+    """After 3000 kinematic iterations the hand model reaches random reachable hand goals better
+    than an agent that acts at random."""
+    trial = run_trial(
+        tmp_path / "t", TrialSettings(iterations=3000, seed=0, checkpoint_every=3000), progress=False
+    )
+    agent = trial.agent
+    rng = np.random.default_rng(123)
+    room = Playroom("kinematic", seed=77)
+    learned, random_errors = [], []
+    for _ in range(60):
+        # A reachable goal: the hand trajectory of another random command, at the 5 samples.
+        joints = arm_trajectory(rng.uniform(-1, 1, 21))[:, list(DEFAULT_WORLD.sample_indices)]
+        target = hand_positions(joints)  # (5, 2)
+        goal = np.concatenate([target[:, 0], target[:, 1]])
+        context = room.context()
+        m = agent.exploit(0, context, goal)
+        learned.append(np.linalg.norm(room.act_arm(m).s[0:10] - goal))
+        random_errors.append(np.linalg.norm(room.act_arm(rng.uniform(-1, 1, 21)).s[0:10] - goal))
+    assert np.mean(learned) < 0.7 * np.mean(random_errors)
+
+
+# Bad input ----------------------------------------------------------------------------------
+def test_directory_with_a_trial_is_refused_without_resume(tmp_path):
+    out = tmp_path / "t"
+    args = ["run", "--iterations", "20", "--seed", "0", "--out", str(out), "--quiet"]
+    assert _run_cli(*args).returncode == 0
+    before = storage.read_arrays(out / CHECKPOINT_FILE)[0]
+    again = _run_cli(*args)
+    assert again.returncode == 2 and "already holds a trial" in again.stderr
+    assert len(again.stderr.strip().splitlines()) == 1
+    other = _run_cli("run", "--iterations", "20", "--seed", "5", "--out", str(out), "--resume")
+    assert other.returncode == 2 and "another configuration" in other.stderr
+    _arrays_equal(before, storage.read_arrays(out / CHECKPOINT_FILE)[0])
+
+
+def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys):
+    a_file = tmp_path / "file"
+    a_file.write_text("x")
+    cases = [
+        ["run", "--out", str(tmp_path / "a"), "--iterations", "0"],
+        ["run", "--out", str(tmp_path / "a"), "--iterations", "-5"],
+        ["run", "--out", str(tmp_path / "a"), "--grasp", "magnetic"],
+        ["run", "--out", str(tmp_path / "a"), "--frobnicate"],
+        ["run", "--out", str(a_file), "--iterations", "5"],
+    ]
+    for argv in cases:
+        with pytest.raises(SystemExit) as exc:
+            code = main(argv)
+            raise SystemExit(code)
+        assert exc.value.code == 2, argv
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1, err
+    assert a_file.read_text() == "x"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")
+def test_unwritable_directory_is_refused(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    result = _run_cli("run", "--iterations", "5", "--out", str(locked / "t"))
+    assert result.returncode == 2 and "cannot write" in result.stderr
+
+
+def test_truncated_checkpoint_is_a_clear_error_and_destroys_nothing(tmp_path):
+    out = tmp_path / "t"
+    args = ["run", "--iterations", "40", "--seed", "0", "--out", str(out), "--quiet"]
+    args += ["--checkpoint-every", "20"]
+    assert _run_cli(*args).returncode == 0
+    checkpoint = out / CHECKPOINT_FILE
+    checkpoint.write_bytes(checkpoint.read_bytes()[:300])
+    damaged = checkpoint.read_bytes()
+    log_files = sorted(p.name for p in (out / "log").iterdir())
+    result = _run_cli(*args, "--resume")
+    assert result.returncode == 2
+    assert "checkpoint" in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    assert checkpoint.read_bytes() == damaged
+    assert sorted(p.name for p in (out / "log").iterdir()) == log_files
+
+
+def test_agent_is_the_learner_package():
+    # The trial wires sim and learner; learner itself must not import MuJoCo or sim.
+    code = "import sys, learner.agent; print(any(m.startswith(('mujoco','sim','dm_control')) for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.stdout.strip() == "False"
+    assert Agent(LearnerConfig(), np.random.default_rng(0)) is not None
