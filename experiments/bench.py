@@ -55,9 +55,58 @@ def tracking_figures(n_commands: int = 1000) -> Iterator[tuple[str, float, str]]
     yield "hand_tracking_error_max", errors.max() * 1e3, "mm"
 
 
+def learner_figures(n_rows: int = 80000) -> Iterator[tuple[str, float, str]]:
+    """The memory's query against brute force, and the learner's own cost per iteration."""
+    from learner import bench as learner_bench
+
+    query = learner_bench.query_ratio(n_rows=n_rows)
+    worst = max(query["by_dim"].values(), key=lambda d: d["memory_s"] / d["brute_s"])
+    yield (
+        f"inverse_query_over_brute_force_at_{n_rows}_rows",
+        query["ratio"],
+        "ratio (target <= 0.1)",
+    )
+    yield "inverse_query", worst["memory_s"] * 1e6, "us"
+    yield "brute_force_scan", worst["brute_s"] * 1e6, "us"
+    overhead = learner_bench.learner_overhead(n_rows=n_rows)
+    yield (
+        f"learner_overhead_per_iteration_at_{n_rows}_rows",
+        overhead["mean_s"] * 1e3,
+        ("ms (target <= 1)"),
+    )
+    yield "peak_memory_with_all_models_full", _peak_rss_mb(), "MB (target < 1024)"
+
+
+def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
+    """A whole kinematic trial: speed of a short run, projected to the study's 80000."""
+    import tempfile
+
+    from experiments.trial import TrialSettings, run_trial
+
+    with tempfile.TemporaryDirectory() as out:
+        settings = TrialSettings(grasp="kinematic", iterations=iterations, checkpoint_every=1000)
+        start = time.perf_counter()
+        run_trial(out, settings, progress=False)
+        elapsed = time.perf_counter() - start
+    yield f"kinematic_trial_{iterations}_iterations", iterations / elapsed, "iterations/s"
+    yield (
+        "kinematic_trial_80000_projected",
+        80000 / (iterations / elapsed) / 60,
+        ("min (target < 5)"),
+    )
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
 SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "world": world_figures,
     "tracking": tracking_figures,
+    "learner": learner_figures,
+    "trial": trial_figures,
 }
 
 

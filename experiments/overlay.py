@@ -22,7 +22,13 @@ from sim.playroom import TRACKED
 # block, "sound", is not drawn in the room.
 POSITION_BLOCKS = TRACKED
 # Geom whose colour stands for each tracked object in the overlay.
-OBJECT_GEOMS = {"hand": "hand", "stick": "stick_handle", "toy1": "toy1", "toy2": "toy2", "toy3": "toy3"}
+OBJECT_GEOMS = {
+    "hand": "hand",
+    "stick": "stick_handle",
+    "toy1": "toy1",
+    "toy2": "toy2",
+    "toy3": "toy3",
+}
 # Body whose height is the plane the objects move in (m); every tracked object sits there.
 PLANE_BODY = "stick"
 

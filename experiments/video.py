@@ -133,18 +133,25 @@ class FrameRecorder:
     """Renders a room's scene offscreen: on demand (`capture`) and, while attached to the
     room's `step_observers`, once after every control step.
 
-    size: (width, height) px; camera: a camera of the MJCF ("top" or "hand_view"). Frames are
+    size: (width, height) px; camera: a camera of the MJCF ("top" or "hand_view"); shadows:
+    MuJoCo's shadow maps, off by default: on Mesa's software EGL they halve the frame rate, and
+    from the top camera they wash out the table and hide the reach circles. Frames are
     (height, width, 3) uint8; each comes with the `CameraView` it was taken from. Close it
     (or use it as a context manager): an EGL context left to the garbage collector at exit
     prints errors.
     """
 
     def __init__(
-        self, room: Playroom, size: tuple[int, int] = DEFAULT_SIZE, camera: str = "top"
+        self,
+        room: Playroom,
+        size: tuple[int, int] = DEFAULT_SIZE,
+        camera: str = "top",
+        shadows: bool = False,
     ) -> None:
         self.width, self.height = parse_size(size)
         self.room = room
         self.camera = camera
+        self.shadows = bool(shadows)
         model = room.physics.model.ptr
         _check_camera(camera, model)
         limit = (model.vis.global_.offwidth, model.vis.global_.offheight)
@@ -167,6 +174,7 @@ class FrameRecorder:
         """Render the room as it is now; append and return the frame."""
         model, data = self.room.physics.model.ptr, self.room.physics.data.ptr
         self._renderer.update_scene(data, camera=self.camera)
+        self._renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
         frame = self._renderer.render()
         self.frames.append(frame)
         self.views.append(CameraView.of(model, data, self.camera, self.width, self.height))
@@ -284,7 +292,8 @@ class EpisodeRenderer:
     """Renders iterations of rooms into one video with overlay and sound.
 
     Per iteration: `lead_frames` still frames of the scene before the movement, one frame per
-    control step, and `hold_frames` copies of the last frame, all with the overlay. Frames
+    control step, and `hold_frames` copies of the last frame, all with the overlay. size, fps,
+    camera, shadows: as for `FrameRecorder`; audio_rate: Hz of the sound track. Frames
     stream to a temporary H.264 file as each iteration ends, so memory holds one iteration.
     Use it as a context manager, or call `close`.
     """
@@ -297,6 +306,7 @@ class EpisodeRenderer:
         lead_frames: int = LEAD_FRAMES,
         hold_frames: int = HOLD_FRAMES,
         audio_rate: int = AUDIO_RATE,
+        shadows: bool = False,
     ) -> None:
         self.size = parse_size(size)
         self.fps = _check_fps(fps)
@@ -308,6 +318,7 @@ class EpisodeRenderer:
         self.camera = camera
         self.lead_frames, self.hold_frames = lead_frames, hold_frames
         self.audio_rate = int(audio_rate)
+        self.shadows = shadows
         self.n_frames = 0
         self.clips: list[Clip] = []
         self._recorder: FrameRecorder | None = None
@@ -422,7 +433,7 @@ class EpisodeRenderer:
         if self._recorder is None or self._model is not model:
             if self._recorder is not None:
                 self._recorder.close()
-            self._recorder = FrameRecorder(room, self.size, self.camera)
+            self._recorder = FrameRecorder(room, self.size, self.camera, self.shadows)
             self._overlay = Overlay(model, *self.size, fps=self.fps)
             self._model = model
         self._recorder.room = room
@@ -466,13 +477,15 @@ def render_random(
     word_audio: Callable[[str], tuple[np.ndarray, int]] | None = None,
     lead_frames: int = LEAD_FRAMES,
     hold_frames: int = HOLD_FRAMES,
+    shadows: bool = False,
 ) -> Path:
     """Film `iterations` random commands (half arm, half voice, in a seeded random order) in a
     new room and write the MP4 with overlay and sound to `out_path`.
 
     voice_audio(m (28,)) -> (waveform, rate Hz): the agent's sound of a voice command, placed at
     the movement's start; word_audio(word) -> (waveform, rate Hz): the caregiver's word, placed
-    at the step she says it. None: silent. Every argument is checked before anything renders.
+    at the step she says it. None: silent. shadows: see `FrameRecorder`. Every argument is
+    checked before anything renders.
     """
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations <= 0:
         raise ValueError(f"iterations must be a positive integer, got {iterations!r}")
@@ -484,7 +497,7 @@ def render_random(
     rng = np.random.default_rng([seed, 1])  # a stream apart from the room's own
     spaces = ["arm"] * math.ceil(iterations / 2) + ["voice"] * (iterations // 2)
     spaces = [spaces[k] for k in rng.permutation(iterations)]
-    with EpisodeRenderer(size, fps, camera, lead_frames, hold_frames) as renderer:
+    with EpisodeRenderer(size, fps, camera, lead_frames, hold_frames, shadows=shadows) as renderer:
         for space in spaces:
             m = rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM)
             clips: list[Clip] = []
@@ -516,13 +529,16 @@ def render_figures(
     rng = np.random.default_rng(seed)
     room = Playroom(grasp="physical", seed=seed)
     with FrameRecorder(room, (width, height)) as recorder:
-        recorder.capture()  # the first frame pays for uploading textures
-        start = time.perf_counter()
-        for _ in range(frames):
-            recorder.capture()
-        fps = frames / (time.perf_counter() - start)
-        recorder.take()
-        yield f"render_fps_{width}x{height}", fps, "frames/s"
+        for shadows, suffix in ((False, ""), (True, "_with_shadows")):
+            recorder.shadows = shadows
+            recorder.capture()  # the first frame of a style pays for its set-up
+            start = time.perf_counter()
+            for _ in range(frames):
+                recorder.capture()
+            fps = frames / (time.perf_counter() - start)
+            recorder.take()
+            yield f"render_fps_{width}x{height}{suffix}", fps, "frames/s"
+        recorder.shadows = False
 
         def iteration_s(filmed: bool, repeats: int) -> float:
             best = math.inf
