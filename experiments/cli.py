@@ -74,6 +74,35 @@ def cmd_run(args: argparse.Namespace) -> None:
     )
 
 
+def cmd_eval(args: argparse.Namespace) -> None:
+    """Competence, strategies and vocal accuracy of a trial's final state."""
+    from experiments import storage
+    from experiments.evaluation import EvaluationSettings, evaluate_trial
+    from experiments.trial import TrialError
+
+    try:
+        summary = evaluate_trial(
+            args.dir, EvaluationSettings(n_placements=args.placements), progress=not args.quiet
+        )
+    except (TrialError, storage.CorruptFileError) as exc:
+        raise UsageError(str(exc)) from None
+    c, v = summary["competence"], summary["vocal"]
+    print(
+        f"{args.dir}: {summary['grasp']}, seed {summary['seed']}, "
+        f"{summary['evaluated_at_iteration']} iterations"
+    )
+    print(
+        "  normalised competence (0 = random agent, 1 = perfect): "
+        + ", ".join(f"{k} {val:+.2f}" for k, val in c.items())
+    )
+    for ring, shares in summary["strategy_share"].items():
+        print(f"  strategies {ring}: " + ", ".join(f"{k} {v:.0%}" for k, v in shares.items()))
+    print(
+        f"  words below 0.4: {v['share_below_threshold']:.0%}; median best distance: names "
+        f"{v['median_names']:.2f}, distractors {v['median_distractors']:.2f}"
+    )
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -112,6 +141,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue the trial in --out")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("eval", help="evaluate a trial: competence, strategies, vocal errors")
+    p.add_argument("dir", help="a trial directory written by `playroom run`")
+    p.add_argument("--placements", type=_positive_int, default=100, help="per ring")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_eval)
 
     p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
     p.add_argument("section", nargs="*", help="sections to run (default: all)")

@@ -166,18 +166,8 @@ class Trial:
         storage.write_arrays(self.dir / CHECKPOINT_FILE, arrays, meta)
 
     def _load_checkpoint(self) -> None:
-        path = self.dir / CHECKPOINT_FILE
-        try:
-            arrays, meta = storage.read_arrays(path)
-            agent_state = dict(meta["agent"])
-            agent_state.update(
-                {k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")}
-            )
-            self.agent.load_state_dict(agent_state)
-            self.room.set_state({**meta["room"], "physics": arrays["room/physics"]})
-            self.best_word_distance = arrays["best_word_distance"].copy()
-        except (KeyError, ValueError, TypeError) as exc:
-            raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
+        meta = restore_checkpoint(self.dir, self.agent, self.room)
+        self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
         self.iteration = int(meta["iteration"])
         self.counts = dict(meta["counts"])
         # Log chunks past the checkpoint belong to the lost work: they are rewritten.
@@ -271,6 +261,42 @@ class Trial:
         storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
         if word_rows:
             storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+
+
+def restore_checkpoint(trial_dir: str | os.PathLike, agent: Agent, room: Playroom) -> dict:
+    """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
+    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored."""
+    path = Path(trial_dir) / CHECKPOINT_FILE
+    arrays, meta = storage.read_arrays(path)
+    try:
+        agent_state = dict(meta["agent"])
+        agent_state.update(
+            {k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")}
+        )
+        agent.load_state_dict(agent_state)
+        room.set_state({**meta["room"], "physics": arrays["room/physics"]})
+        meta["best_word_distance"] = arrays["best_word_distance"].copy()
+    except (KeyError, ValueError, TypeError) as exc:
+        raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
+    return meta
+
+
+def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
+    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta)."""
+    trial_dir = Path(trial_dir)
+    if not (trial_dir / CONFIG_FILE).exists():
+        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    if not (trial_dir / CHECKPOINT_FILE).exists():
+        raise TrialError(f"{trial_dir} has no checkpoint yet")
+    config = storage.read_json(trial_dir / CONFIG_FILE)
+    settings = config["trial"]
+    room = Playroom(grasp=settings["grasp"], seed=settings["seed"])
+    agent = Agent(
+        LearnerConfig.from_dict(config["learner"]),
+        np.random.default_rng([settings["seed"], AGENT_STREAM]),
+    )
+    meta = restore_checkpoint(trial_dir, agent, room)
+    return config, agent, room, meta
 
 
 def _split_state(state: dict) -> tuple[dict[str, np.ndarray], dict]:

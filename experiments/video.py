@@ -440,6 +440,10 @@ class EpisodeRenderer:
         return self._recorder
 
     def _write_frame(self, image: np.ndarray) -> None:
+        if self._writer is None and self.n_frames > 0:
+            # The encoder of the frames so far was closed by `write`; a new one would
+            # overwrite them.
+            raise RuntimeError("this video was already written; start a new EpisodeRenderer")
         if self._writer is None:
             mediapy.set_ffmpeg(ffmpeg_exe())
             width, height = self.size
