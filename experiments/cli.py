@@ -103,6 +103,21 @@ def cmd_eval(args: argparse.Namespace) -> None:
     )
 
 
+def cmd_batch(args: argparse.Namespace) -> None:
+    """Many trials on Dask, each run and evaluated; reruns skip what is complete."""
+    from experiments.batch import BatchError, load_spec, run_batch
+
+    try:
+        spec = load_spec(args.profile, args.config)
+        results = run_batch(spec, args.out, scheduler=args.scheduler, n_workers=args.workers)
+    except BatchError as exc:
+        raise UsageError(str(exc)) from None
+    for name, summary in sorted(results.items()):
+        c = summary["competence"]
+        print(f"  {name}: competence ring1 {c['ring1']:+.2f}, all {c['all']:+.2f}")
+    print(f"{args.out}: {len(spec.trials())} trials complete")
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -147,6 +162,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--placements", type=_positive_int, default=100, help="per ring")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_eval)
+
+    p = sub.add_parser("batch", help="many trials on a Dask cluster, each run and evaluated")
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument("--profile", help="a stored profile: smoke, demo or paper")
+    which.add_argument("--config", help="a JSON file of the same form as the profiles")
+    p.add_argument("--out", required=True, help="the batch directory")
+    p.add_argument("--scheduler", help="tcp://HOST:PORT of a running Dask scheduler")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: cores)")
+    p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
     p.add_argument("section", nargs="*", help="sections to run (default: all)")

@@ -112,6 +112,7 @@ class Trial:
         self.iteration = 0
         self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
         self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
+        self.elapsed: float | None = None  # seconds of the last `run_trial`
         if resume and (self.dir / CHECKPOINT_FILE).exists():
             self._load_checkpoint()
 
@@ -331,6 +332,7 @@ def run_trial(
     trial = Trial(out_dir, settings, resume=resume)
     if trial.finished:
         return trial
+    trial.start_iteration = trial.iteration
     start = time.perf_counter()
     trial.run(progress=progress)
     trial.elapsed = time.perf_counter() - start

@@ -50,6 +50,10 @@ CAMERAS = ("top", "hand_view")
 LEAD_FRAMES = 5
 HOLD_FRAMES = 25
 AUDIO_RATE = 44_100  # Hz of the mixed sound track
+# Every clip is scaled to this peak: VocalTractLab's output level varies with the articulation
+# (a word peaks near 0.06, a random babble near 0.002), and a video should let both be heard.
+CLIP_PEAK = 0.5
+MAX_CLIP_GAIN = 1000.0
 # Quality of the H.264 stream (constant rate factor: lower is better and larger).
 VIDEO_CRF = 20
 
@@ -212,12 +216,19 @@ class FrameRecorder:
 
 
 # Sound --------------------------------------------------------------------------------------
-def mix_audio(clips: Sequence[Clip], duration_s: float, rate: int = AUDIO_RATE) -> np.ndarray:
+def mix_audio(
+    clips: Sequence[Clip],
+    duration_s: float,
+    rate: int = AUDIO_RATE,
+    peak: float | None = CLIP_PEAK,
+) -> np.ndarray:
     """One mono track (n,) float32 in [-1, 1] of `duration_s`, n = round(duration_s * rate).
 
     clips: (time_s, waveform (m,) float in [-1, 1], rate_hz); each is resampled to `rate`,
-    added at its time and cut at the end of the track. Overlapping clips add up; the sum is
-    clipped to [-1, 1] rather than wrapped around by the int16 conversion.
+    added at its time and cut at the end of the track. peak: each clip is scaled to this peak
+    (gain at most `MAX_CLIP_GAIN`), so that a quiet babble is heard as well as a word; None
+    keeps the clips' levels. Overlapping clips add up; the sum is clipped to [-1, 1] rather
+    than wrapped around by the int16 conversion.
     """
     track = np.zeros(int(round(duration_s * rate)), dtype=np.float64)
     for k, (time_s, waveform, clip_rate) in enumerate(clips):
@@ -233,6 +244,10 @@ def mix_audio(clips: Sequence[Clip], duration_s: float, rate: int = AUDIO_RATE) 
         if clip_rate != rate:
             g = math.gcd(int(clip_rate), rate)
             wave = resample_poly(wave, rate // g, int(clip_rate) // g)
+        if peak is not None and wave.size:
+            # Silence (peak 0) stays silence; near-silence is not blown up into noise.
+            loudest = np.abs(wave).max()
+            wave = wave * min(peak / loudest, MAX_CLIP_GAIN) if loudest > 0 else wave
         start = int(round(time_s * rate))
         end = min(len(track), start + len(wave))
         if end > start:

@@ -119,9 +119,8 @@ def test_render_random_writes_mp4_with_sound(tmp_path):
         return tone()
 
     video.render_random(
-        "kinematic", 3, out, iterations=2, size=SIZE, voice_audio=voice_audio, lead_frames=0,
-        hold_frames=0,
-    )  # fmt: skip
+        "kinematic", 3, out, 2, SIZE, voice_audio=voice_audio, lead_frames=0, hold_frames=0
+    )
     n_frames, _ = imageio_ffmpeg.count_frames_and_secs(str(out))
     assert n_frames == 2 * STEPS
     assert calls == [(VOICE_DIM,)]  # half arm, half voice
@@ -165,11 +164,15 @@ def test_projection_of_a_point_behind_the_camera_is_nan():
 
 def test_mix_audio_places_resamples_and_clips():
     ones = np.ones(800)  # 0.1 s at 8 kHz
-    track = video.mix_audio([(0.5, ones, 8000), (0.55, ones, 8000)], 1.0, rate=16_000)
+    track = video.mix_audio([(0.5, ones, 8000), (0.55, ones, 8000)], 1.0, 16_000, peak=None)
     assert track.shape == (16_000,) and track.dtype == np.float32
-    assert np.all(track[: 7_990] == 0) and np.all(track[10_500:] == 0)
+    assert np.all(track[:7_990] == 0) and np.all(track[10_500:] == 0)
     assert track[8_400] == pytest.approx(1.0, abs=0.05)  # one clip
     assert track[9_000] == 1.0  # two overlapping clips, clipped to full scale
+    # Clips are brought to a common peak: a quiet babble is heard as well as a loud word.
+    levelled = video.mix_audio([(0.0, 0.002 * ones, 8000), (0.5, 0.2 * ones, 8000)], 1.0, 8000)
+    assert levelled[400] == pytest.approx(video.CLIP_PEAK)  # the quiet babble
+    assert levelled[4400] == pytest.approx(video.CLIP_PEAK)  # the loud word
     # A clip running past the end is cut, not an error.
     assert video.mix_audio([(0.95, ones, 8000)], 1.0, rate=8000).shape == (8000,)
     with pytest.raises(ValueError, match="NaN"):
@@ -203,6 +206,13 @@ def test_bad_output_fails_before_rendering(tmp_path, monkeypatch):
             video.render_random("kinematic", 0, locked / "out.mp4", size=SIZE)
 
 
+def test_failed_mux_is_a_render_error(tmp_path):
+    wav = tmp_path / "sound.wav"
+    video.write_wav(wav, np.zeros(100), 8000)
+    with pytest.raises(video.RenderError, match="ffmpeg failed"):
+        video.mux(tmp_path / "no_such_video.mp4", wav, tmp_path / "out.mp4")
+
+
 def test_unknown_camera_is_refused(tmp_path):
     with pytest.raises(ValueError, match="camera"):
         video.render_random("kinematic", 0, tmp_path / "out.mp4", size=SIZE, camera="side")
@@ -228,6 +238,8 @@ def test_refused_command_adds_no_frames():
 
 
 def test_render_figures_are_positive():
-    figures = {name: value for name, value, _ in video.render_figures(SIZE, frames=5, plain_repeats=2, filmed_repeats=1)}
+    figures = video.render_figures(SIZE, frames=5, plain_repeats=2, filmed_repeats=1)
+    figures = {name: value for name, value, _ in figures}
     assert figures[f"render_fps_{SIZE[0]}x{SIZE[1]}"] > 0
+    assert figures[f"render_fps_{SIZE[0]}x{SIZE[1]}_with_shadows"] > 0
     assert figures["filmed_over_unfilmed_iteration"] > 1.0
