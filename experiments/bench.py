@@ -12,6 +12,7 @@ from collections.abc import Callable, Iterator
 import mujoco
 import numpy as np
 
+from experiments.video import render_figures
 from sim import Playroom
 from sim.config import ARM_DIM
 from sim.physics import CONTROL_SUBSTEPS
@@ -107,6 +108,7 @@ SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "tracking": tracking_figures,
     "learner": learner_figures,
     "trial": trial_figures,
+    "render": render_figures,
 }
 
 

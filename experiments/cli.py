@@ -118,6 +118,54 @@ def cmd_batch(args: argparse.Namespace) -> None:
     print(f"{args.out}: {len(spec.trials())} trials complete")
 
 
+def _iteration_list(text: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected I,J,... integers, got {text!r}") from None
+    if not values:
+        raise argparse.ArgumentTypeError("no iteration given")
+    return values
+
+
+def cmd_render(args: argparse.Namespace) -> None:
+    """An MP4 of a trial's iterations (replayed exactly), or of random commands."""
+    from experiments.replay import ReplayError, render_trial
+    from experiments.video import RenderError, render_random
+    from sim.dmp import voice_trajectory
+    from sim.vocal.audio import synthesise, synthesise_word
+
+    try:
+        if args.random:
+            if args.dir is not None:
+                raise UsageError("give either a trial directory or --random, not both")
+            count = len(args.iterations) if args.iterations else 4
+            path = render_random(
+                args.grasp, args.seed, args.out, iterations=count, size=args.size,
+                fps=args.fps, camera=args.camera,
+                voice_audio=lambda m: synthesise(voice_trajectory(m)),
+                word_audio=synthesise_word,
+            )  # fmt: skip
+            print(path)
+            return
+        if args.dir is None:
+            raise UsageError("give a trial directory, or --random")
+        path, replayed = render_trial(
+            args.dir, args.out, iterations=args.iterations, use_highlights=args.highlights,
+            size=args.size, fps=args.fps, camera=args.camera,
+        )  # fmt: skip
+    except (ValueError, RenderError, ReplayError) as exc:
+        raise UsageError(f"{exc} (offscreen rendering needs EGL; try MUJOCO_GL=osmesa)"
+                         if isinstance(exc, RenderError) else str(exc)) from None  # fmt: skip
+    for r in replayed:
+        verdict = "events as logged" if r.matches else "DIFFERS from the log"
+        print(f"  iteration {r.iteration}: replayed {verdict}")
+        if not r.matches:
+            diff = {k: (r.logged.get(k), v) for k, v in r.replayed.items() if r.logged.get(k) != v}
+            print(f"    logged vs replayed: {diff}")
+    print(path)
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -171,6 +219,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", help="tcp://HOST:PORT of a running Dask scheduler")
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: cores)")
     p.set_defaults(func=cmd_batch)
+
+    p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
+    p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")
+    p.add_argument("--out", required=True, help="the MP4 file to write")
+    which = p.add_mutually_exclusive_group()
+    which.add_argument("--iterations", type=_iteration_list, help="I,J,...: iterations to film")
+    which.add_argument("--highlights", action="store_true", help="first grasp, tool use, ...")
+    p.add_argument("--random", action="store_true", help="random commands in a new room")
+    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.add_argument("--size", default="640x480", help="WxH, even numbers")
+    p.add_argument("--fps", type=float, default=50.0)
+    p.add_argument("--camera", choices=["top", "hand_view"], default="top")
+    p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
     p.add_argument("section", nargs="*", help="sections to run (default: all)")

@@ -15,6 +15,7 @@ import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
+from matplotlib.ticker import MaxNLocator
 
 STRATEGIES = ("hand", "tool", "vocal")
 STRATEGY_COLOURS = {"hand": "tab:blue", "tool": "tab:orange", "vocal": "tab:green"}
@@ -89,8 +90,8 @@ def competence_map(
         ax.set_xlabel("toy x")
         ax.set_ylabel("toy y")
     bar = fig.colorbar(mesh, ax=axes, shrink=0.85, extend="min")
-    bar.set_label("normalised competence (%): 0 = random agent, 100 = perfect")
-    fig.suptitle("Competence to bring a toy to the centre, by toy position (paper Fig. 3)")
+    bar.set_label("normalised competence (%)\n0 = random agent, 100 = perfect")
+    fig.suptitle("Competence to bring a toy to the centre\nby toy position (paper Fig. 3)")
     return fig
 
 
@@ -128,10 +129,10 @@ def strategy_by_distance(
         ax.set_ylim(0, 100)
         ax.set_xlabel("toy distance to the arm's base")
         ax.set_ylabel("share of tests (%)")
-        ax.set_title(f"{group} ({len(rows)} tests, {int(counts.min())}+ per bin)")
+        ax.set_title(f"{group} ({len(rows)} tests, at least {int(counts.min())} per bin)")
         ax.legend(loc="center left", title="strategy")
         ax.grid(alpha=0.3)
-    fig.suptitle("Strategy chosen to retrieve a toy, by its distance (paper Fig. 4)")
+    fig.suptitle("Strategy chosen to retrieve a toy\nby its distance (paper Fig. 4)")
     return fig
 
 
@@ -165,9 +166,10 @@ def vocal_errors(vocal: pd.DataFrame, groups: list[str], threshold: float) -> Fi
         ax.set_title(f"{group}: {100 * below:.0f}% of words below {threshold}")
         ax.set_xlabel("best distance between the word and the agent's sounds")
         ax.set_ylabel("number of words")
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlim(0, top)
         ax.legend(fontsize=8)
-    fig.suptitle("Accuracy of imitations of the caregiver's words (paper Fig. 5)")
+    fig.suptitle("Accuracy of imitations of the caregiver's words\n(paper Fig. 5)")
     return fig
 
 
@@ -175,17 +177,20 @@ def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshol
     """Developmental curves: tool use, recognised words and best word distance over time.
     `bands`: group, metric, iteration, mean, low, high (`experiments.report.curve_bands`)."""
     fig, axes = _panels(3, width=5.0, height=4.2)
+    # (axis, [(metric, line style)], y label, scale, largest possible value): intervals are
+    # clipped to what a share or a distance can be, the t interval of few trials is not.
     panels = (
-        (axes[0], [("tool_use", "-")], "toy moved with the stick (% of arm movements)", 100),
-        (axes[1], [("word_recognised", "-")], "word recognised (% of vocal movements)", 100),
+        (axes[0], [("tool_use", "-")], "toy moved with the stick (% of arm movements)", 100, 1),
+        (axes[1], [("word_recognised", "-")], "word recognised (% of vocal movements)", 100, 1),
         (
             axes[2],
             [("best_distance_names", "-"), ("best_distance_distractors", "--")],
             "best distance to the caregiver's words",
             1,
+            np.inf,
         ),
     )
-    for ax, metrics, ylabel, scale in panels:
+    for ax, metrics, ylabel, scale, top in panels:
         ax.axvspan(0, bootstrap, color="0.9", zorder=0)
         for group in groups:
             colour = group_colour(groups, group)
@@ -201,8 +206,8 @@ def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshol
                 )
                 ax.fill_between(
                     band["iteration"],
-                    scale * band["low"],
-                    scale * band["high"],
+                    scale * band["low"].clip(0, top),
+                    scale * band["high"].clip(0, top),
                     color=colour,
                     alpha=0.2,
                     lw=0,
@@ -260,7 +265,8 @@ def competence_by_ring(
     ax.axhline(
         100 * paper_mean, color="0.3", ls="--", lw=1, label=f"paper: {paper_mean:.0%} on average"
     )
-    ax.set_xticks(range(len(scopes)), [s.replace("ring", "ring ") for s in scopes])
+    names = {"all": "all rings"}
+    ax.set_xticks(range(len(scopes)), [names.get(s, s.replace("ring", "ring ")) for s in scopes])
     ax.set_ylabel("normalised competence (%): 0 = random agent")
     ax.set_title("Competence per trial (dots), mean and 95% interval (diamonds)")
     ax.legend(fontsize=8)

@@ -361,8 +361,14 @@ def competence_summary(trials: pd.DataFrame) -> pd.DataFrame:
         for scope in COMPETENCE_SCOPES:
             mean, low, high = mean_ci(table[f"competence_{scope}"].to_numpy())
             rows.append(
-                {"group": group, "scope": scope, "n": len(table), "mean": mean, "low": low,
-                 "high": high}
+                {
+                    "group": group,
+                    "scope": scope,
+                    "n": len(table),
+                    "mean": mean,
+                    "low": low,
+                    "high": high,
+                }
             )
     return pd.DataFrame(rows, columns=["group", "scope", "n", "mean", "low", "high"])
 
@@ -463,8 +469,573 @@ def curve_bands(curves: pd.DataFrame) -> pd.DataFrame:
     ):
         mean, low, high = mean_ci(table["value"].to_numpy())
         rows.append(
-            {"group": group, "metric": metric, "iteration": iteration, "mean": mean, "low": low,
-             "high": high}
+            {
+                "group": group,
+                "metric": metric,
+                "iteration": iteration,
+                "mean": mean,
+                "low": low,
+                "high": high,
+            }
         )
     columns = ["group", "metric", "iteration", "mean", "low", "high"]
     return pd.DataFrame(rows, columns=columns).sort_values(["group", "metric", "iteration"])
+
+
+# --------------------------------------------------------------------------------------------
+# Rendering
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """Reach limits and recognition threshold, read from the trials' own settings."""
+
+    hand_limit: float
+    stick_limit: float
+    threshold: float
+    bootstrap: int
+
+    @classmethod
+    def of(cls, results: BatchResults) -> _Geometry:
+        config = next(iter(results.configs.values()))
+        try:
+            hand = float(sum(config["world"]["segment_lengths"]))
+            stick = hand + float(config["world"]["stick_length"])
+            threshold = float(config["voice"]["recognition_distance"])
+            learner = config["learner"]
+            bootstrap = int(learner["bootstrap_arm"]) + int(learner["bootstrap_voice"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ReportError(
+                f"the trials' config.json lacks a setting the report needs ({exc})"
+            ) from None
+        return cls(hand, stick, threshold, bootstrap)
+
+
+def _pct(x: float, digits: int = 0) -> str:
+    return "n/a" if not np.isfinite(x) else f"{100 * x:.{digits}f}%"
+
+
+def _num(x: float, digits: int = 2) -> str:
+    return "n/a" if not np.isfinite(x) else f"{x:.{digits}f}"
+
+
+def _p(p: float) -> str:
+    if not np.isfinite(p):
+        return "n/a"
+    return f"p = {p:.3f}" if p >= 1e-3 else f"p = {p:.1e}"
+
+
+def _ci_text(row: pd.Series) -> str:
+    if not np.isfinite(row["mean"]):
+        return "n/a"
+    if not np.isfinite(row["low"]):
+        return f"{_pct(row['mean'], 1)} (n={row['n']}, no interval)"
+    interval = f"[95% CI {_pct(row['low'], 1)}, {_pct(row['high'], 1)}]"
+    return f"{_pct(row['mean'], 1)} {interval} (n={row['n']})"
+
+
+def _shares_text(row: pd.Series) -> str:
+    if row["n"] == 0:
+        return "no tests here"
+    shares = " / ".join(_pct(row[s]) for s in figures.STRATEGIES)
+    return f"{shares} (n={row['n']} tests)"
+
+
+def _statistics(results: BatchResults, geometry: _Geometry) -> dict[str, Any]:
+    """Every number of the report, per group."""
+    summary = competence_summary(results.trials)
+    strategies = strategy_table(results.competence, geometry.hand_limit, geometry.stick_limit)
+    vocal = {
+        g: vocal_summary(results.vocal[results.vocal["group"] == g], geometry.threshold)
+        for g in results.groups
+    }
+    return {"competence": summary, "strategies": strategies, "vocal": vocal}
+
+
+def _paper_rows(results: BatchResults, numbers: dict, geometry: _Geometry) -> list[list[str]]:
+    """[result, paper, value of group 1, value of group 2, ...], one list per row."""
+    g = results.groups
+    comp, strat, vocal = numbers["competence"], numbers["strategies"], numbers["vocal"]
+
+    def competence_of(scope: str) -> list[str]:
+        return [_ci_text(comp[(comp["group"] == x) & (comp["scope"] == scope)].iloc[0]) for x in g]
+
+    def shares_of(region: str) -> list[str]:
+        return [
+            _shares_text(strat[(strat["group"] == x) & (strat["region"] == region)].iloc[0])
+            for x in g
+        ]
+
+    h, s, t = geometry.hand_limit, geometry.stick_limit, geometry.threshold
+    return [
+        [
+            "Normalised competence, all rings (mean over trials)",
+            "46% better than random on average",
+            *competence_of("all"),
+        ],
+        [
+            f"… ring 1 (toy within hand reach, d < {h:g})",
+            "not published",
+            *competence_of("ring1"),
+        ],
+        [f"… ring 2 ({h:g} ≤ d < {s:g})", "not published", *competence_of("ring2")],
+        [f"… ring 3 ({s:g} ≤ d ≤ 1)", "not published", *competence_of("ring3")],
+        [
+            f"Strategy hand / tool / vocal, centre region (d < {h:g})",
+            "~65% / 15–20% / 15–20%",
+            *shares_of("centre"),
+        ],
+        [
+            f"Strategy hand / tool / vocal, between hand and stick limits ({h:g} ≤ d < {s:g})",
+            "~50% / 20–30% / 20–30%",
+            *shares_of("between limits"),
+        ],
+        [
+            f"Strategy hand / tool / vocal, at distance 1 (d ≥ {DISTANCE_ONE:g})",
+            "38% / 13% / 49%",
+            *shares_of("distance 1"),
+        ],
+        [
+            f"Words imitated within {t:g} (best distance)",
+            "88% (of 2964 words)",
+            *[f"{_pct(vocal[x]['share_below'])} (of {vocal[x]['n_words']} words)" for x in g],
+        ],
+        ["Median best distance, toy names", "0.23", *[_num(vocal[x]["median_names"]) for x in g]],
+        [
+            "Median best distance, distractors",
+            "0.30",
+            *[_num(vocal[x]["median_distractors"]) for x in g],
+        ],
+        [
+            "Mann-Whitney U, names vs distractors (two-sided)",
+            "p < 1e-72 (1482 vs 1482 words)",
+            *[f"U = {_num(vocal[x]['u'], 1)}, {_p(vocal[x]['p'])}" for x in g],
+        ],
+    ]
+
+
+def _figures(results: BatchResults, geometry: _Geometry) -> list[tuple[str, str, str, bytes]]:
+    """[(file name, title, caption, PNG bytes)] of every figure of a report."""
+    g = results.groups
+    numbers = competence_summary(results.trials)
+    drawn = [
+        (
+            "fig3-competence-map.png",
+            "Competence by toy position (paper Fig. 3)",
+            "Normalised competence 1 − Σerror / Σrandom error of the tests whose toy lies in "
+            "each cell, pooled over trials: 0% is the random agent on the same placements, 100% "
+            "a perfect retrieval. Dashed circles: hand and stick reach limits.",
+            figures.competence_map(
+                results.competence, g, geometry.hand_limit, geometry.stick_limit
+            ),
+        ),
+        (
+            "fig4-strategies.png",
+            "Strategy preference by toy distance (paper Fig. 4)",
+            "Share of tests in which the agent chose the hand (arm, stick still), the tool "
+            "(arm, stick moved) or its voice (caregiver's help), by the toy's distance to the "
+            "arm's base. Vertical bars: hand and stick reach limits.",
+            figures.strategy_by_distance(
+                results.competence, g, geometry.hand_limit, geometry.stick_limit
+            ),
+        ),
+        (
+            "fig5-vocal-errors.png",
+            "Vocal imitation errors, toy names vs distractors (paper Fig. 5)",
+            "Best (lowest) distance between each of the caregiver's words and any sound the "
+            f"agent produced; below {geometry.threshold:g} the caregiver recognises the word.",
+            figures.vocal_errors(results.vocal, g, geometry.threshold),
+        ),
+        (
+            "development.png",
+            "Developmental curves",
+            "Per window of iterations, mean over trials with a 95% interval: share of arm "
+            "movements that moved a toy with the stick, share of vocal movements the caregiver "
+            "recognised as a word, and mean best distance so far to the trial's toy names "
+            "(solid) and distractors (dashed). Grey: the random bootstrap.",
+            figures.development(
+                curve_bands(results.curves), g, geometry.bootstrap, geometry.threshold
+            ),
+        ),
+        (
+            "competence-per-trial.png",
+            "Competence per trial and ring",
+            "Each dot is one trial's normalised competence; diamonds: mean with 95% t interval.",
+            figures.competence_by_ring(results.trials, numbers, g, PAPER_COMPETENCE),
+        ),
+    ]
+    return [(name, title, caption, figures.png_bytes(fig)) for name, title, caption, fig in drawn]
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    """An HTML table of plain-text cells (escaped here, once)."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>" for row in rows
+    )
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _seeds_text(seeds: list[int]) -> str:
+    seeds = sorted(seeds)
+    if seeds == list(range(seeds[0], seeds[-1] + 1)) and len(seeds) > 2:
+        return f"{seeds[0]}–{seeds[-1]}"
+    return ", ".join(map(str, seeds))
+
+
+def _settings_html(results: BatchResults) -> str:
+    rows = []
+    for group in results.groups:
+        trials = results.trials[results.trials["group"] == group]
+        config = results.configs[group]
+        rows.append(
+            [
+                group,
+                str(len(trials)),
+                _seeds_text(trials["seed"].tolist()),
+                str(config["trial"]["iterations"]),
+                str(config["trial"]["babbling"]),
+                str(trials["n_placements"].iloc[0]),
+                str(config.get("package_version", "?")),
+            ]
+        )
+    table = _table(
+        [
+            "group",
+            "trials",
+            "seeds",
+            "iterations",
+            "babbling",
+            "placements per ring",
+            "package version",
+        ],
+        rows,
+    )
+    details = "".join(
+        f"<details><summary>Full settings of {html.escape(g)}</summary><pre>"
+        f"{html.escape(json.dumps(c, indent=2, sort_keys=True))}</pre></details>"
+        for g, c in results.configs.items()
+    )
+    return table + details
+
+
+def _trials_html(results: BatchResults) -> str:
+    rows = [
+        [
+            r["trial"],
+            r["group"],
+            str(r["seed"]),
+            *[_pct(r[f"competence_{k}"], 1) for k in COMPETENCE_SCOPES],
+            _pct(r["share_below_threshold"]),
+            _num(r["median_names"]),
+            _num(r["median_distractors"]),
+            str(r["diverged"]),
+            _num(r["seconds"] / r["timed_iterations"], 4),
+        ]
+        for _, r in results.trials.iterrows()
+    ]
+    header = [
+        "trial",
+        "group",
+        "seed",
+        "competence",
+        "ring 1",
+        "ring 2",
+        "ring 3",
+        "words < threshold",
+        "median names",
+        "median distractors",
+        "diverged",
+        "s / iteration",
+    ]
+    return _table(header, rows)
+
+
+_STYLE = """
+body { font-family: sans-serif; max-width: 1250px; margin: 2em auto; color: #222; }
+table { border-collapse: collapse; margin: 1em 0; font-size: 0.92em; }
+th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top; }
+th { background: #eee; }
+img { max-width: 100%; border: 1px solid #ddd; }
+figure { margin: 1.5em 0; }
+figcaption { font-size: 0.9em; color: #444; max-width: 1000px; }
+pre { font-size: 0.8em; background: #f7f7f7; padding: 0.5em; }
+"""
+
+
+def _page(
+    title: str, sections: list[tuple[str, str]], pngs: list[tuple[str, str, str, bytes]]
+) -> str:
+    parts = [f"<h1>{html.escape(title)}</h1>"]
+    for heading, body in sections:
+        parts.append(f"<h2>{heading}</h2>{body}")
+    parts.append("<h2>Figures</h2>")
+    for name, fig_title, caption, data in pngs:
+        uri = "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+        parts.append(
+            f'<figure><h3>{html.escape(fig_title)}</h3><img src="{uri}" alt="{html.escape(name)}">'
+            f"<figcaption>{html.escape(caption)} (file: {html.escape(name)})</figcaption></figure>"
+        )
+    return (
+        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+        f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>"
+        + "\n".join(parts)
+        + "</body></html>\n"
+    )
+
+
+def _write_atomically(path: Path, data: bytes) -> None:
+    """A reader sees the old file or the new one, never half of one."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        # mkstemp makes the file private (0600); a report is meant to be read by others.
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _write_all(
+    out_dir: Path, pngs: list[tuple[str, str, str, bytes]], page_name: str, page: str
+) -> Path:
+    """The PNGs, then the page last: a page on disk means its figures are there too."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for name, _, _, data in pngs:
+        _write_atomically(out_dir / name, data)
+    target = out_dir / page_name
+    _write_atomically(target, page.encode("utf-8"))
+    return target
+
+
+def write_report(batch_dir: str | os.PathLike, out_dir: str | os.PathLike | None = None) -> Path:
+    """Figures (PNG) and `report.html` of a batch, its numbers beside the paper's; into
+    `out_dir` (default: the batch directory). Returns the path of report.html."""
+    results = collect(batch_dir)
+    geometry = _Geometry.of(results)
+    numbers = _statistics(results, geometry)
+    pngs = _figures(results, geometry)
+    header = [
+        "result",
+        "paper (500 runs, 80000 iterations)",
+        *[f"this batch: {g}" for g in results.groups],
+    ]
+    paper = _table(header, _paper_rows(results, numbers, geometry)).replace("<tr><td>", "<tr><td>")
+    n = len(results.trials)
+    sections = [
+        (
+            "Settings",
+            f"<p>{n} trial{'s' if n != 1 else ''} in "
+            f"<code>{html.escape(str(results.batch_dir))}</code>.</p>" + _settings_html(results),
+        ),
+        ("Paper vs this batch", paper + _NOTES),
+        ("Trials", _trials_html(results)),
+    ]
+    page = _page(f"Playroom batch report: {results.batch_dir.name}", sections, pngs)
+    return _write_all(
+        Path(out_dir) if out_dir is not None else results.batch_dir, pngs, REPORT_FILE, page
+    )
+
+
+_NOTES = (
+    "<p>Competence intervals are Student t intervals over trials. Strategy shares are pooled "
+    "over every test of the region; hand = arm with the stick still, tool = arm with the stick "
+    "moved, vocal = voice. The paper's numbers come from protocol.md (“Evaluation after "
+    "learning”).</p>"
+)
+
+
+# --------------------------------------------------------------------------------------------
+# Comparison of two batches
+# --------------------------------------------------------------------------------------------
+
+
+def _sides(dir_a: Path, dir_b: Path) -> tuple[BatchResults, BatchResults]:
+    """One group per side: two batches of one group each, or one batch of exactly two."""
+    a = collect(dir_a)
+    if dir_a.resolve() == dir_b.resolve():
+        if len(a.groups) != 2:
+            raise ReportError(
+                f"{dir_a} holds {len(a.groups)} group(s) ({', '.join(a.groups)}): comparing a "
+                "batch with itself needs exactly two groups"
+            )
+        return a.select(a.groups[0]), a.select(a.groups[1])
+    b = collect(dir_b)
+    for side, path in ((a, dir_a), (b, dir_b)):
+        if len(side.groups) != 1:
+            raise ReportError(
+                f"{path} holds {len(side.groups)} groups ({', '.join(side.groups)}): a "
+                "comparison takes one group per batch"
+            )
+    if a.groups == b.groups:  # two batches of the same backend: tell them apart by folder
+        a = a.relabel({a.groups[0]: f"{a.groups[0]} ({dir_a.name})"})
+        b = b.relabel({b.groups[0]: f"{b.groups[0]} ({dir_b.name})"})
+    return a, b
+
+
+def _merge(a: BatchResults, b: BatchResults) -> BatchResults:
+    tables = {
+        name: pd.concat([getattr(a, name), getattr(b, name)], ignore_index=True)
+        for name in ("trials", "competence", "vocal", "curves")
+    }
+    return BatchResults(batch_dir=a.batch_dir, **tables, configs={**a.configs, **b.configs})
+
+
+def _per_second(cost: float) -> str:
+    return "not recorded" if not np.isfinite(cost) else f"{1000 * cost:.2f} ms / iteration"
+
+
+def _difference_rows(a: BatchResults, b: BatchResults, geometry: _Geometry) -> list[list[str]]:
+    """[statistic, A, B, test, p] rows: is the difference between the two groups real?"""
+    rows = []
+    summary = competence_summary(pd.concat([a.trials, b.trials]))
+    for scope in COMPETENCE_SCOPES:
+        values = [side.trials[f"competence_{scope}"].to_numpy() for side in (a, b)]
+        texts = [
+            _ci_text(
+                summary[(summary["group"] == s.groups[0]) & (summary["scope"] == scope)].iloc[0]
+            )
+            for s in (a, b)
+        ]
+        name = "all rings" if scope == "all" else scope.replace("ring", "ring ")
+        rows.append(
+            [
+                f"Normalised competence, {name}",
+                *texts,
+                "Welch t (per-trial values)",
+                _p(welch(*values)[1]),
+            ]
+        )
+    counts = strategy_counts(
+        pd.concat([a.competence, b.competence]), geometry.hand_limit, geometry.stick_limit
+    )
+    shares = strategy_table(
+        pd.concat([a.competence, b.competence]), geometry.hand_limit, geometry.stick_limit
+    )
+    for region in regions(geometry.hand_limit, geometry.stick_limit):
+        table = counts[counts["region"] == region]
+        texts = [
+            _shares_text(
+                shares[(shares["group"] == s.groups[0]) & (shares["region"] == region)].iloc[0]
+            )
+            for s in (a, b)
+        ]
+        matrix = table.set_index("group").loc[[a.groups[0], b.groups[0]], list(figures.STRATEGIES)]
+        rows.append(
+            [
+                f"Strategy hand / tool / vocal, {region}",
+                *texts,
+                "χ² (pooled tests, groups × strategies)",
+                _p(chi_square(matrix.to_numpy())[1]),
+            ]
+        )
+    t = geometry.threshold
+    below = [(s.vocal["best_distance"] < t).sum() for s in (a, b)]
+    total = [len(s.vocal) for s in (a, b)]
+    fisher = stats.fisher_exact([[below[0], total[0] - below[0]], [below[1], total[1] - below[1]]])
+    rows.append(
+        [
+            f"Words imitated within {t:g}",
+            *[
+                f"{_pct(n / m if m else math.nan)} of {m}"
+                for n, m in zip(below, total, strict=True)
+            ],
+            "Fisher exact (pooled words)",
+            _p(float(fisher.pvalue)),
+        ]
+    )
+    for label, pick in (
+        ("all words", lambda v: v),
+        ("toy names", lambda v: v[v["is_name"]]),
+        ("distractors", lambda v: v[~v["is_name"]]),
+    ):
+        values = [pick(s.vocal)["best_distance"].to_numpy(dtype=float) for s in (a, b)]
+        rows.append(
+            [
+                f"Best word distance, {label} (median)",
+                *[f"{_num(np.median(v)) if len(v) else 'n/a'} (n={len(v)})" for v in values],
+                "Mann-Whitney U (pooled words)",
+                _p(mann_whitney(*values)[1]),
+            ]
+        )
+    diverged = [int(s.trials["diverged"].sum()) for s in (a, b)]
+    iterations = [int(s.trials["iterations"].sum()) for s in (a, b)]
+    rows.append(
+        [
+            "Iterations whose physics diverged",
+            *[f"{d} of {n}" for d, n in zip(diverged, iterations, strict=True)],
+            "χ² (pooled iterations)",
+            _p(
+                chi_square(
+                    np.array([[d, n - d] for d, n in zip(diverged, iterations, strict=True)])
+                )[1]
+            ),
+        ]
+    )
+    costs = [cost_per_iteration(s.trials) for s in (a, b)]
+    ratio = costs[1] / costs[0] if all(np.isfinite(costs)) and costs[0] > 0 else math.nan
+    rows.append(
+        [
+            "Cost per iteration (timing.json: trial seconds / iterations)",
+            *[_per_second(c) for c in costs],
+            f"ratio {b.groups[0]} / {a.groups[0]}",
+            "n/a" if not np.isfinite(ratio) else f"{ratio:.2f}×",
+        ]
+    )
+    return rows
+
+
+def write_comparison(
+    dir_a: str | os.PathLike, dir_b: str | os.PathLike, out_dir: str | os.PathLike
+) -> Path:
+    """Two batches (e.g. kinematic and physical grasping) side by side: every figure with one
+    panel per batch, the paper table with both, tests of their differences and the cost per
+    iteration of each. `dir_a` may equal `dir_b` for one batch of exactly two groups. Writes
+    `comparison.html` and `comparison-*.png` into out_dir; returns the page's path."""
+    dir_a, dir_b = Path(dir_a), Path(dir_b)
+    a, b = _sides(dir_a, dir_b)
+    merged = _merge(a, b)
+    geometry = _Geometry.of(merged)
+    numbers = _statistics(merged, geometry)
+    pngs = [
+        (f"comparison-{name}", title, caption, data)
+        for name, title, caption, data in _figures(merged, geometry)
+    ]
+    g = merged.groups
+    paper = _table(
+        ["result", "paper (500 runs, 80000 iterations)", *g],
+        _paper_rows(merged, numbers, geometry),
+    )
+    tests = _table(
+        ["statistic", g[0], g[1], "test of the difference", "p"],
+        _difference_rows(a, b, geometry),
+    )
+    where = " and ".join(
+        f"<code>{html.escape(str(p))}</code>" for p in dict.fromkeys((dir_a, dir_b))
+    )
+    sections = [
+        (
+            "Settings",
+            f"<p>{len(a.trials)} + {len(b.trials)} trials from {where}.</p>"
+            + _settings_html(merged),
+        ),
+        ("Differences between the two", tests + _TEST_NOTES),
+        ("Paper vs the two", paper + _NOTES),
+        ("Trials", _trials_html(merged)),
+    ]
+    page = _page(f"Playroom comparison: {g[0]} vs {g[1]}", sections, pngs)
+    return _write_all(Path(out_dir), pngs, COMPARISON_FILE, page)
+
+
+_TEST_NOTES = (
+    "<p>All tests are two-sided. Competence: Welch's t test on the per-trial values (needs two "
+    "trials a side). Strategies: χ² test of independence on the pooled counts of tests in the "
+    "region (tests of one trial are not independent, so read it as indicative). Word "
+    "distances: Mann-Whitney U on the best distances of every word of every trial. Cost: "
+    "wall-clock seconds per iteration that the trials recorded in timing.json.</p>"
+)

@@ -106,9 +106,7 @@ class Trial:
         self.settings = settings
         self.config = full_config(settings)
         self._check_directory(resume)
-        self.room = Playroom(grasp=settings.grasp, seed=settings.seed)
-        learner_config = LearnerConfig.from_dict(self.config["learner"])
-        self.agent = Agent(learner_config, np.random.default_rng([settings.seed, AGENT_STREAM]))
+        self.agent, self.room = fresh_trial_parts(self.config)
         self.iteration = 0
         self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
         self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
@@ -217,37 +215,10 @@ class Trial:
         if proposal.motor_space == "voice":
             distances = word_distances(feedback.s[50:60], self.room.vocal_tract.config)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
-        return self._log_row(proposal, feedback)
-
-    def _log_row(self, proposal, feedback) -> dict:
-        row = {
-            "iteration": self.iteration,
-            "motor_space": proposal.motor_space,
-            "model": -1 if proposal.model is None else int(proposal.model),
-            "stick_grasped": False,
-            "stick_moved_by": "",
-            "word_recognised": "",
-            "caregiver_said": "",
-            "diverged": False,
-        }
-        for toy in TOYS:
-            row[f"{toy}_moved_by"] = ""
-        for e in feedback.events:
-            if e.kind == ev.STICK_GRASPED:
-                row["stick_grasped"] = True
-            elif e.kind == ev.STICK_MOVED:
-                row["stick_moved_by"] = e.by
-            elif e.kind == ev.TOY_MOVED:
-                row[f"{e.obj}_moved_by"] = e.by
-                self.counts["tool_uses"] += e.by == "stick"
-            elif e.kind == ev.WORD_RECOGNISED:
-                row["word_recognised"] = e.word
-                self.counts["words_recognised"] += 1
-            elif e.kind == ev.CAREGIVER_SAID:
-                row["caregiver_said"] = e.word
-            elif e.kind == ev.DIVERGED:
-                row["diverged"] = True
-                self.counts["diverged"] += 1
+        row = log_row(self.iteration, proposal, feedback)
+        self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)
+        self.counts["words_recognised"] += row["word_recognised"] != ""
+        self.counts["diverged"] += row["diverged"]
         return row
 
     def _word_row(self) -> dict:
@@ -262,6 +233,46 @@ class Trial:
         storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
         if word_rows:
             storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+
+
+def log_row(iteration: int, proposal, feedback) -> dict:
+    """One row of the iterations log: what was tried and what happened."""
+    row = {
+        "iteration": iteration,
+        "motor_space": proposal.motor_space,
+        "model": -1 if proposal.model is None else int(proposal.model),
+        "stick_grasped": False,
+        "stick_moved_by": "",
+        **{f"{toy}_moved_by": "" for toy in TOYS},
+        "word_recognised": "",
+        "caregiver_said": "",
+        "diverged": False,
+    }
+    for e in feedback.events:
+        if e.kind == ev.STICK_GRASPED:
+            row["stick_grasped"] = True
+        elif e.kind == ev.STICK_MOVED:
+            row["stick_moved_by"] = e.by
+        elif e.kind == ev.TOY_MOVED:
+            row[f"{e.obj}_moved_by"] = e.by
+        elif e.kind == ev.WORD_RECOGNISED:
+            row["word_recognised"] = e.word
+        elif e.kind == ev.CAREGIVER_SAID:
+            row["caregiver_said"] = e.word
+        elif e.kind == ev.DIVERGED:
+            row["diverged"] = True
+    return row
+
+
+def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
+    """The agent and room of a trial's iteration 0, as its config makes them."""
+    settings = config["trial"]
+    room = Playroom(grasp=settings["grasp"], seed=settings["seed"])
+    agent = Agent(
+        LearnerConfig.from_dict(config["learner"]),
+        np.random.default_rng([settings["seed"], AGENT_STREAM]),
+    )
+    return agent, room
 
 
 def restore_checkpoint(trial_dir: str | os.PathLike, agent: Agent, room: Playroom) -> dict:
@@ -290,12 +301,7 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
     if not (trial_dir / CHECKPOINT_FILE).exists():
         raise TrialError(f"{trial_dir} has no checkpoint yet")
     config = storage.read_json(trial_dir / CONFIG_FILE)
-    settings = config["trial"]
-    room = Playroom(grasp=settings["grasp"], seed=settings["seed"])
-    agent = Agent(
-        LearnerConfig.from_dict(config["learner"]),
-        np.random.default_rng([settings["seed"], AGENT_STREAM]),
-    )
+    agent, room = fresh_trial_parts(config)
     meta = restore_checkpoint(trial_dir, agent, room)
     return config, agent, room, meta
 

@@ -519,18 +519,32 @@ def render_random(
     with EpisodeRenderer(size, fps, camera, lead_frames, hold_frames, shadows=shadows) as renderer:
         for space in spaces:
             m = rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM)
-            clips: list[Clip] = []
-            if space == "voice" and voice_audio is not None:
-                clips.append((0.0, *voice_audio(m)))
-            before = renderer.n_frames
-            feedback = renderer.render_iteration(room, space, m, model="random", audio=clips)
-            if word_audio is not None:
-                start = (before + lead_frames) / renderer.fps
-                for e in feedback.events:
-                    if e.kind == ev.CAREGIVER_SAID and e.word:
-                        t = start + e.step / renderer.fps
-                        renderer.clips.append((t, *word_audio(e.word)))
+            film_iteration(renderer, room, space, m, voice_audio, word_audio, model="random")
         return renderer.write(out)
+
+
+def film_iteration(
+    renderer: EpisodeRenderer,
+    room: Playroom,
+    motor_space: str,
+    m: np.ndarray,
+    voice_audio: Callable[[np.ndarray], tuple[np.ndarray, int]] | None = None,
+    word_audio: Callable[[str], tuple[np.ndarray, int]] | None = None,
+    **overlay,
+) -> Feedback:
+    """Film one command with its sounds: the agent's voice from the movement's start, the
+    caregiver's word at the step she says it. `overlay` goes to `render_iteration`."""
+    clips: list[Clip] = []
+    if motor_space == "voice" and voice_audio is not None:
+        clips.append((0.0, *voice_audio(m)))
+    before = renderer.n_frames
+    feedback = renderer.render_iteration(room, motor_space, m, audio=clips, **overlay)
+    if word_audio is not None:
+        start = (before + renderer.lead_frames) / renderer.fps
+        for e in feedback.events:
+            if e.kind == ev.CAREGIVER_SAID and e.word:
+                renderer.clips.append((start + e.step / renderer.fps, *word_audio(e.word)))
+    return feedback
 
 
 # Speed --------------------------------------------------------------------------------------

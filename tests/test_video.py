@@ -243,3 +243,38 @@ def test_render_figures_are_positive():
     assert figures[f"render_fps_{SIZE[0]}x{SIZE[1]}"] > 0
     assert figures[f"render_fps_{SIZE[0]}x{SIZE[1]}_with_shadows"] > 0
     assert figures["filmed_over_unfilmed_iteration"] > 1.0
+
+
+# Replaying a trial ----------------------------------------------------------------------------
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_replayed_trial_iterations_reproduce_the_logged_events(tmp_path, grasp):
+    from experiments.replay import render_trial
+    from experiments.trial import TrialSettings, run_trial
+
+    trial = tmp_path / "trial"
+    run_trial(trial, TrialSettings(grasp=grasp, iterations=30, seed=3, checkpoint_every=30),
+              progress=False)  # fmt: skip
+    path, replayed = render_trial(
+        trial, tmp_path / "r.mp4", iterations=[4, 11], size="96x64", progress=False
+    )
+    assert [r.iteration for r in replayed] == [4, 11]
+    assert all(r.matches for r in replayed), [(r.logged, r.replayed) for r in replayed]
+    assert path.exists() and path.stat().st_size > 0
+
+
+def test_render_refuses_bad_trial_input_with_one_line(tmp_path, capsys):
+    from experiments.cli import main
+    from experiments.trial import TrialSettings, run_trial
+
+    trial = tmp_path / "trial"
+    run_trial(trial, TrialSettings(iterations=10, seed=0, checkpoint_every=10), progress=False)
+    cases = [
+        [str(trial), "--out", str(tmp_path / "a.mp4"), "--iterations", "10"],
+        [str(tmp_path / "nowhere"), "--out", str(tmp_path / "b.mp4"), "--iterations", "1"],
+        [str(trial), "--out", str(tmp_path / "missing" / "c.mp4"), "--iterations", "1"],
+    ]
+    for argv in cases:
+        assert main(["render", *argv]) == 2, argv
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1, err
+    assert not list(tmp_path.glob("*.mp4"))
