@@ -16,10 +16,26 @@ $(INSTALLED): pyproject.toml
 
 install: $(INSTALLED)
 
-## run: the project's main job with its embedded defaults
-run: $(INSTALLED)
-	$(BIN)/playroom random --grasp kinematic --iterations 40 --seed 0
-	$(BIN)/playroom random --grasp physical --iterations 40 --seed 0
+DEMO := $(OUT)/demo
+
+## run: the main job: the demo batch (both backends), its report and the comparison
+run: experiment
+	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare
+
+## experiment: the demo profile's batch and its report
+experiment: $(INSTALLED)
+	$(BIN)/playroom batch --profile demo --out $(DEMO)
+	$(BIN)/playroom report $(DEMO)
+
+## compare: the demo profile's two backends and their comparison
+compare: $(INSTALLED)
+	$(BIN)/playroom batch --profile demo --out $(DEMO)
+	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare
+
+## video: the highlights of the demo batch's first physical trial
+video: $(INSTALLED)
+	$(BIN)/playroom batch --profile demo --out $(DEMO)
+	$(BIN)/playroom render $(DEMO)/physical-random-seed0000 --highlights --out $(OUT)/highlights.mp4
 
 ## test: lint, then the test suite (under 5 minutes on 2 cores)
 test: lint

@@ -166,6 +166,26 @@ def cmd_render(args: argparse.Namespace) -> None:
     print(path)
 
 
+def cmd_report(args: argparse.Namespace) -> None:
+    """Figures and report.html of a batch, its numbers beside the paper's."""
+    from experiments.report import ReportError, write_report
+
+    try:
+        print(write_report(args.dir, args.out))
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def cmd_compare(args: argparse.Namespace) -> None:
+    """Two batches (or one batch of both backends, given twice) side by side."""
+    from experiments.report import ReportError, write_comparison
+
+    try:
+        print(write_comparison(args.dir_a, args.dir_b, args.out))
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -219,6 +239,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", help="tcp://HOST:PORT of a running Dask scheduler")
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: cores)")
     p.set_defaults(func=cmd_batch)
+
+    p = sub.add_parser("report", help="figures and report.html of a batch beside the paper")
+    p.add_argument("dir", help="a batch directory of evaluated trials")
+    p.add_argument("--out", help="where to write (default: DIR)")
+    p.set_defaults(func=cmd_report)
+
+    p = sub.add_parser("compare", help="kinematic vs physical batches side by side")
+    p.add_argument("dir_a", help="a batch directory (e.g. the kinematic one)")
+    p.add_argument("dir_b", help="another batch directory, or DIR_A again if it holds both")
+    p.add_argument("--out", required=True, help="where to write comparison.html")
+    p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")

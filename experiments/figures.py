@@ -38,9 +38,11 @@ def png_bytes(fig: Figure) -> bytes:
     return buffer.getvalue()
 
 
-def _panels(n: int, width: float = 5.2, height: float = 4.6) -> tuple[Figure, list]:
+def _panels(
+    n: int, width: float = 5.2, height: float = 4.6, sharey: bool = False
+) -> tuple[Figure, list]:
     fig = Figure(figsize=(width * n, height), layout="constrained")
-    axes = fig.subplots(1, n, squeeze=False)[0]
+    axes = fig.subplots(1, n, squeeze=False, sharey=sharey)[0]
     return fig, list(axes)
 
 
@@ -87,6 +89,8 @@ def competence_map(
         ax.set_xlim(-1, 1)
         ax.set_ylim(-1, 1)
         ax.set_aspect("equal")
+        ax.set_xticks([-1, -0.5, 0, 0.5, 1])
+        ax.set_yticks([-1, -0.5, 0, 0.5, 1])
         ax.set_xlabel("toy x")
         ax.set_ylabel("toy y")
     bar = fig.colorbar(mesh, ax=axes, shrink=0.85, extend="min")
@@ -130,15 +134,18 @@ def strategy_by_distance(
         ax.set_xlabel("toy distance to the arm's base")
         ax.set_ylabel("share of tests (%)")
         ax.set_title(f"{group} ({len(rows)} tests, at least {int(counts.min())} per bin)")
-        ax.legend(loc="center left", title="strategy")
         ax.grid(alpha=0.3)
+    # One legend for all panels, under them: inside a panel it would hide some curve.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncols=3, title="strategy")
     fig.suptitle("Strategy chosen to retrieve a toy\nby its distance (paper Fig. 4)")
     return fig
 
 
 def vocal_errors(vocal: pd.DataFrame, groups: list[str], threshold: float) -> Figure:
     """Fig. 5: best imitation error of each word, toy names against distractors."""
-    fig, axes = _panels(len(groups))
+    # One count scale for all panels, so that two batches compare at a glance.
+    fig, axes = _panels(len(groups), sharey=True)
     finite = vocal["best_distance"][np.isfinite(vocal["best_distance"])]
     top = max(1.2, float(finite.max()) if len(finite) else 1.2)
     edges = np.arange(0.0, top + 0.05, 0.05)
@@ -244,7 +251,7 @@ def competence_by_ring(
     """Per-trial normalised competence, overall and per ring (dots), with the means and 95%
     intervals of `summary` (group, scope, mean, low, high: `experiments.report`)."""
     scopes = list(dict.fromkeys(summary["scope"]))
-    fig = Figure(figsize=(7.5, 4.6), layout="constrained")
+    fig = Figure(figsize=(9.0, 4.6), layout="constrained")
     ax = fig.subplots()
     rng = np.random.default_rng(0)  # jitter only, fixed so that figures are reproducible
     width = 0.7 / len(groups)
@@ -269,6 +276,6 @@ def competence_by_ring(
     ax.set_xticks(range(len(scopes)), [names.get(s, s.replace("ring", "ring ")) for s in scopes])
     ax.set_ylabel("normalised competence (%): 0 = random agent")
     ax.set_title("Competence per trial (dots), mean and 95% interval (diamonds)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(alpha=0.3, axis="y")
     return fig

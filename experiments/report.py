@@ -202,11 +202,11 @@ def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[
         )
 
 
-def _curve_rows(trial_dir: Path, iterations: int, names: set[str]) -> pd.DataFrame:
-    """A trial's developmental curves, in windows of iterations."""
-    log = read_log(trial_dir)
-    if log.empty:
-        raise ReportError(f"{trial_dir.name} has no iteration log (log/iterations-*.parquet)")
+def _curve_rows(
+    log: pd.DataFrame, words: pd.DataFrame, iterations: int, names: set[str]
+) -> pd.DataFrame:
+    """A trial's developmental curves from its logs: rates in windows of iterations (about
+    CURVE_POINTS of them), best word distances wherever the words log has a row."""
     window = max(50, round(iterations / CURVE_POINTS / 50) * 50)
     end = (log["iteration"].to_numpy() // window + 1) * window
     arm = log["motor_space"] == "arm"
@@ -239,7 +239,6 @@ def _curve_rows(trial_dir: Path, iterations: int, names: set[str]) -> pd.DataFra
                 ("word_recognised", "voice"),
             )
         ]
-    words = read_log(trial_dir, "words")
     if not words.empty:
         values = words.drop(columns="iteration").replace(np.inf, np.nan)
         for metric, chosen in (
@@ -256,6 +255,35 @@ def _curve_rows(trial_dir: Path, iterations: int, names: set[str]) -> pd.DataFra
                 )
             )
     return pd.concat(parts, ignore_index=True)
+
+
+def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(iterations log, words log) of a trial; ReportError if unreadable or missing."""
+    try:
+        log, words = read_log(trial_dir), read_log(trial_dir, "words")
+    except storage.CorruptFileError as exc:
+        raise ReportError(str(exc).replace("\n", " ")) from None
+    if log.empty:
+        raise ReportError(f"{trial_dir.name} has no iteration log (log/iterations-*.parquet)")
+    return log, words
+
+
+def _eval_numbers(trial_dir: Path, summary: dict) -> dict[str, float]:
+    """A trial's numbers from its eval.json."""
+    try:
+        vocal = summary["vocal"]
+        return {
+            **{f"competence_{k}": summary["competence"][k] for k in COMPETENCE_SCOPES},
+            "mean_error": summary["mean_error"],
+            "mean_random_error": summary["mean_random_error"],
+            "share_below_threshold": vocal["share_below_threshold"],
+            "median_names": vocal["median_names"],
+            "median_distractors": vocal["median_distractors"],
+        }
+    except (KeyError, TypeError) as exc:
+        raise ReportError(
+            f"{trial_dir / EVAL_FILE} lacks {exc}: evaluate the trial again (`playroom eval`)"
+        ) from None
 
 
 def _timing(trial_dir: Path) -> tuple[float, float]:
@@ -281,6 +309,9 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
             config.get("trial", {})
         ):
             raise ReportError(f"{d / CONFIG_FILE} lacks the trial's grasp/babbling/seed")
+    for d, summary in zip(dirs, evals, strict=True):
+        if not isinstance(summary, dict):
+            raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
     mixed = len({c["trial"]["babbling"] for c in configs}) > 1
     labels = [_group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
     group_configs: dict[str, dict] = {}
@@ -299,11 +330,11 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
         comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
         voc = _read_table(d / VOCAL_FILE).assign(**keys)
+        log, words = _read_logs(d)
         curve = _curve_rows(
-            d, config["trial"]["iterations"], set(voc.loc[voc["is_name"], "word"])
+            log, words, config["trial"]["iterations"], set(voc.loc[voc["is_name"], "word"])
         ).assign(**keys)
         seconds, timed = _timing(d)
-        log = read_log(d)
         trials.append(
             {
                 **keys,
@@ -312,12 +343,7 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
                 "babbling": config["trial"]["babbling"],
                 "iterations": config["trial"]["iterations"],
                 "n_placements": summary.get("n_placements"),
-                **{f"competence_{k}": summary["competence"][k] for k in COMPETENCE_SCOPES},
-                "mean_error": summary["mean_error"],
-                "mean_random_error": summary["mean_random_error"],
-                "share_below_threshold": summary["vocal"]["share_below_threshold"],
-                "median_names": summary["vocal"]["median_names"],
-                "median_distractors": summary["vocal"]["median_distractors"],
+                **_eval_numbers(d, summary),
                 "diverged": int(log["diverged"].sum()),
                 "seconds": seconds,
                 "timed_iterations": timed,

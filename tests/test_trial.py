@@ -89,7 +89,9 @@ def test_a_3000_iteration_run_learns_to_reach_hand_goals(tmp_path):
     """After 3000 kinematic iterations the hand model reaches random reachable hand goals better
     than an agent that acts at random."""
     trial = run_trial(
-        tmp_path / "t", TrialSettings(iterations=3000, seed=0, checkpoint_every=3000), progress=False
+        tmp_path / "t",
+        TrialSettings(iterations=3000, seed=0, checkpoint_every=3000),
+        progress=False,
     )
     agent = trial.agent
     rng = np.random.default_rng(123)
@@ -168,7 +170,10 @@ def test_truncated_checkpoint_is_a_clear_error_and_destroys_nothing(tmp_path):
 
 def test_agent_is_the_learner_package():
     # The trial wires sim and learner; learner itself must not import MuJoCo or sim.
-    code = "import sys, learner.agent; print(any(m.startswith(('mujoco','sim','dm_control')) for m in sys.modules))"
+    code = (
+        "import sys, learner.agent; "
+        "print(any(m.split('.')[0] in ('mujoco', 'sim', 'dm_control') for m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.stdout.strip() == "False"
     assert Agent(LearnerConfig(), np.random.default_rng(0)) is not None

@@ -1,0 +1,248 @@
+"""Reports of a batch (`experiments.report`): files, embedded figures, statistics checked by
+hand, and bad input refused with one line and nothing written."""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from experiments import figures
+from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
+from experiments.report import (
+    COMPARISON_FILE,
+    REPORT_FILE,
+    ReportError,
+    chi_square,
+    collect,
+    cost_per_iteration,
+    mann_whitney,
+    mean_ci,
+    strategy_table,
+    vocal_summary,
+    welch,
+    write_comparison,
+    write_report,
+)
+from experiments.trial import TrialSettings, run_trial
+
+DATA_URI = re.compile(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"')
+
+
+@pytest.fixture(scope="session")
+def batches(tmp_path_factory) -> dict[str, Path]:
+    """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0."""
+    root = tmp_path_factory.mktemp("batches")
+    out = {}
+    for grasp, seeds in (("kinematic", (0, 1)), ("physical", (0,))):
+        batch = root / grasp
+        for seed in seeds:
+            trial = batch / f"{grasp}-random-seed{seed:04d}"
+            settings = TrialSettings(grasp=grasp, iterations=300, seed=seed, checkpoint_every=300)
+            run_trial(trial, settings, progress=False)
+            evaluate_trial(trial, EvaluationSettings(n_placements=3))
+        out[grasp] = batch
+    return out
+
+
+def _copy_batch(batches: dict[str, Path], target: Path, grasps=("kinematic",)) -> Path:
+    for grasp in grasps:
+        for trial in batches[grasp].iterdir():
+            if trial.is_dir():
+                shutil.copytree(trial, target / trial.name)
+    return target
+
+
+def _embedded(page: Path, out_dir: Path, pattern: str) -> None:
+    """Every PNG written is embedded in the page, byte for byte, and nothing else is."""
+    pngs = sorted(out_dir.glob(pattern))
+    uris = DATA_URI.findall(page.read_text())
+    assert len(pngs) >= 5
+    assert len(uris) == len(pngs)
+    assert sorted(base64.b64decode(u) for u in uris) == sorted(p.read_bytes() for p in pngs)
+    for png in pngs:
+        assert png.read_bytes().startswith(b"\x89PNG")
+
+
+# Collecting ----------------------------------------------------------------------------------
+
+
+def test_collect_reads_every_trial_into_tables(batches):
+    results = collect(batches["kinematic"])
+    assert results.groups == ["kinematic"]
+    assert sorted(results.trials["seed"]) == [0, 1]
+    # 3 rings x 3 placements x 3 toys per trial, 6 words per trial.
+    assert len(results.competence) == 2 * 27 and len(results.vocal) == 2 * 6
+    assert set(results.competence["strategy"]) <= {"hand", "tool", "vocal"}
+    assert set(results.curves["metric"]) >= {"tool_use", "word_recognised", "best_distance_names"}
+    assert results.curves["iteration"].max() == 300
+    assert results.trials["seconds"].isna().all()  # no timing.json
+
+
+# Reports -------------------------------------------------------------------------------------
+
+
+def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
+    out = tmp_path / "report"
+    page = write_report(batches["kinematic"], out)
+    assert page == out / REPORT_FILE
+    _embedded(page, out, "*.png")
+    text = page.read_text()
+    # The paper's numbers sit beside the batch's.
+    for published in ("46%", "0.23", "0.30", "88%", "1e-72", "38% / 13% / 49%"):
+        assert published in text
+    assert "2 trials" in text and "this batch: kinematic" in text
+    assert not list(out.glob(".*.tmp"))
+
+
+def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
+    batch_b = _copy_batch(batches, tmp_path / "physical", grasps=("physical",))
+    for trial in batch_b.iterdir():  # one side recorded its cost, the other did not
+        (trial / "timing.json").write_text(json.dumps({"seconds": 1.5, "iterations": 300}))
+    out = tmp_path / "compare"
+    page = write_comparison(batches["kinematic"], batch_b, out)
+    assert page == out / COMPARISON_FILE
+    _embedded(page, out, "comparison-*.png")
+    text = page.read_text()
+    assert "kinematic" in text and "physical" in text
+    assert "Welch t" in text and "Mann-Whitney U" in text and "χ²" in text
+    assert "not recorded" in text and "5.00 ms / iteration" in text
+
+
+# Statistics on hand-made tables ----------------------------------------------------------------
+
+
+def test_mean_ci_is_the_student_t_interval():
+    # mean 3, s^2 = 2.5, se = sqrt(2.5 / 5) = 0.70711, t(0.975, df 4) = 2.77645
+    mean, low, high = mean_ci(np.array([1.0, 2.0, 3.0, 4.0, 5.0]))
+    assert mean == 3.0
+    assert low == pytest.approx(3 - 2.776445 * 0.7071068, abs=1e-6)
+    assert high == pytest.approx(3 + 2.776445 * 0.7071068, abs=1e-6)
+    assert math.isnan(mean_ci(np.array([0.4]))[1])
+
+
+def test_mann_whitney_and_welch_on_known_cases():
+    # Every a below every b: U = 0; exact two-sided p = 2 / C(6, 3) = 0.1.
+    u, p = mann_whitney(np.array([1.0, 2.0, 3.0]), np.array([4.0, 5.0, 6.0]))
+    assert u == 0.0 and p == pytest.approx(0.1)
+    # Welch: t = (2 - 5) / sqrt(1/3 + 1/3) = -3.6742, df = 4.
+    t, p = welch(np.array([1.0, 2.0, 3.0]), np.array([4.0, 5.0, 6.0]))
+    assert t == pytest.approx(-3.674235, abs=1e-5)
+    assert p == pytest.approx(0.021311, abs=1e-5)
+    assert math.isnan(welch(np.array([1.0]), np.array([2.0, 3.0]))[1])
+
+
+def test_chi_square_ignores_empty_columns():
+    # [[10, 5], [5, 10]]: expected 7.5 everywhere, Yates |O - E| - 0.5 = 2: chi2 = 4 * 4 / 7.5.
+    chi2, p = chi_square(np.array([[10, 0, 5], [5, 0, 10]]))
+    assert chi2 == pytest.approx(16 / 7.5)
+    assert 0 < p < 1
+    assert math.isnan(chi_square(np.array([[3, 0, 0], [4, 0, 0]]))[1])
+
+
+def test_vocal_summary_counts_shares_and_medians():
+    vocal = pd.DataFrame(
+        {
+            "is_name": [True, True, True, False, False, False],
+            "best_distance": [0.1, 0.2, 0.3, 0.5, 0.6, 0.35],
+        }
+    )
+    summary = vocal_summary(vocal, threshold=0.4)
+    assert summary["share_below"] == pytest.approx(4 / 6)
+    assert summary["median_names"] == pytest.approx(0.2)
+    assert summary["median_distractors"] == pytest.approx(0.5)
+    assert summary["u"] == 0.0 and summary["p"] == pytest.approx(0.1)
+
+
+def test_strategy_table_shares_per_region():
+    competence = pd.DataFrame(
+        {
+            "group": "g",
+            "distance": [0.1, 0.2, 0.3, 0.4, 0.6, 0.7, 0.96, 0.99],
+            "strategy": ["hand", "hand", "hand", "tool", "vocal", "hand", "vocal", "vocal"],
+        }
+    )
+    table = strategy_table(competence, hand_limit=0.5, stick_limit=0.75).set_index("region")
+    assert table.loc["centre", ["hand", "tool", "vocal"]].tolist() == [0.75, 0.25, 0.0]
+    assert table.loc["between limits", ["hand", "vocal"]].tolist() == [0.5, 0.5]
+    assert table.loc["distance 1", "vocal"] == 1.0 and table.loc["distance 1", "n"] == 2
+
+
+def test_cost_per_iteration_and_competence_grid():
+    trials = pd.DataFrame({"seconds": [2.0, 4.0, np.nan], "timed_iterations": [100, 100, np.nan]})
+    assert cost_per_iteration(trials) == pytest.approx(0.03)
+    assert math.isnan(cost_per_iteration(trials.iloc[2:]))
+    rows = pd.DataFrame(
+        {
+            "x": [0.1, 0.15, -0.9],
+            "y": [0.1, 0.12, -0.9],
+            "error": [1.0, 2.0, 1.0],
+            "random_error": [2.0, 4.0, 1.0],
+        }
+    )
+    edges, grid, counts = figures.competence_map_grid(rows, n_bins=4)
+    assert counts.sum() == 3
+    assert grid[2, 2] == pytest.approx(1 - 3.0 / 6.0)  # cell [0, 0.5)^2: two tests
+    assert grid[0, 0] == pytest.approx(0.0)
+    assert np.isnan(grid[3, 3])
+
+
+# Bad input ------------------------------------------------------------------------------------
+
+
+def _refused(batch: Path, tmp_path: Path, *words: str) -> None:
+    out = tmp_path / "out"
+    with pytest.raises(ReportError) as info:
+        write_report(batch, out)
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message
+    assert not out.exists()
+
+
+def test_empty_directory_is_refused(tmp_path):
+    (tmp_path / "empty").mkdir()
+    _refused(tmp_path / "empty", tmp_path, "holds no trials")
+
+
+def test_trial_without_evaluation_is_named(batches, tmp_path):
+    batch = _copy_batch(batches, tmp_path / "batch")
+    (batch / "kinematic-random-seed0001" / EVAL_FILE).unlink()
+    _refused(batch, tmp_path, "kinematic-random-seed0001", "eval.json")
+
+
+def test_mismatched_configs_name_the_field(batches, tmp_path):
+    batch = _copy_batch(batches, tmp_path / "batch")
+    path = batch / "kinematic-random-seed0001" / "config.json"
+    config = json.loads(path.read_text())
+    config["world"]["stick_length"] = 0.3
+    path.write_text(json.dumps(config))
+    _refused(batch, tmp_path, "world.stick_length", "mismatched")
+
+
+def test_comparison_of_bad_batches_writes_nothing(batches, tmp_path):
+    (tmp_path / "empty").mkdir()
+    out = tmp_path / "out"
+    with pytest.raises(ReportError):
+        write_comparison(batches["kinematic"], tmp_path / "empty", out)
+    # One batch with both backends compares with itself; with one backend it cannot.
+    with pytest.raises(ReportError, match="exactly two groups"):
+        write_comparison(batches["kinematic"], batches["kinematic"], out)
+    assert not out.exists()
+
+
+def test_a_batch_of_both_backends_holds_two_groups(batches, tmp_path):
+    batch = _copy_batch(batches, tmp_path / "both", grasps=("kinematic", "physical"))
+    results = collect(batch)
+    assert results.groups == ["kinematic", "physical"]
+    physical = results.select("physical")
+    assert physical.groups == ["physical"] and set(physical.competence["group"]) == {"physical"}
+    assert len(physical.trials) == 1
