@@ -14,7 +14,7 @@ import numpy as np
 
 from experiments.video import render_figures
 from sim import Playroom
-from sim.config import ARM_DIM
+from sim.config import ARM_DIM, DEFAULT_WORLD
 from sim.physics import CONTROL_SUBSTEPS
 from sim.tracking import hand_tracking_errors
 
@@ -54,6 +54,47 @@ def tracking_figures(n_commands: int = 1000) -> Iterator[tuple[str, float, str]]
     errors = hand_tracking_errors(n_commands)
     yield "hand_tracking_error_mean", errors.mean() * 1e3, f"mm over {n_commands} commands"
     yield "hand_tracking_error_max", errors.max() * 1e3, "mm"
+
+
+def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
+    """The fitted formant map against the exact path, and the vocal part of an iteration."""
+    from sim.config import VOICE_DIM
+    from sim.dmp import voice_trajectory
+    from sim.vocal.tract import VocalTract
+    from sim.vocal.words import normalise
+
+    rng = np.random.default_rng(0)
+    frames = rng.uniform(-1.0, 1.0, (repeats, 7))
+    fast, exact = VocalTract(exact=False), VocalTract(exact=True)
+    frame = iter(np.tile(frames, (3, 1)))
+    exact_s = _seconds_per_call(lambda: exact.formants(next(frame)), repeats)
+    # The learning loop sends a movement's 50 frames through the map at once.
+    movements = iter(rng.uniform(-1.0, 1.0, (3 * repeats, 50, 7)))
+    fast_s = _seconds_per_call(lambda: fast.formants(next(movements)), repeats) / 50
+    yield "formants_exact_per_frame", exact_s * 1e3, "ms"
+    yield "formants_fast_map_per_frame", fast_s * 1e6, "us (in a movement of 50 frames)"
+    yield "fast_map_speedup", exact_s / fast_s, "x (target >= 1000)"
+    commands = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
+    samples = list(DEFAULT_WORLD.sample_indices)
+
+    def vocal_part() -> None:
+        # What act_voice does with the voice: the DMP, the formants of the 50 frames (the
+        # sound sensor's readings), and the caregiver hearing the 5 samples.
+        formants = fast.formants(voice_trajectory(next(commands)).T)
+        fast.recognise(normalise(formants[samples]))
+
+    yield (
+        "act_voice_vocal_part",
+        _seconds_per_call(vocal_part, repeats) * 1e3,
+        ("ms (target <= 0.5)"),
+    )
+    room = Playroom("kinematic", seed=0)
+    voice = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
+    yield (
+        "act_voice_kinematic_iteration",
+        _seconds_per_call(lambda: room.act_voice(next(voice)), repeats) * 1e3,
+        "ms",
+    )
 
 
 def learner_figures(n_rows: int = 80000) -> Iterator[tuple[str, float, str]]:
@@ -106,6 +147,7 @@ def _peak_rss_mb() -> float:
 SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "world": world_figures,
     "tracking": tracking_figures,
+    "voice": voice_figures,
     "learner": learner_figures,
     "trial": trial_figures,
     "render": render_figures,

@@ -118,16 +118,17 @@ class Playroom:
         during the same 50 steps, as in the study.
         """
         m = _checked_command(m, VOICE_DIM, "voice command")
+        articulators = voice_trajectory(m, self.config).T  # (n_steps, 7)
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
-        actions[:, N_JOINTS:] = voice_trajectory(m, self.config).T
-        return self._run(VOICE, actions)
+        actions[:, N_JOINTS:] = articulators
+        return self._run(VOICE, actions, self.vocal_tract.formants(articulators))
 
-    def _hear(self, actions: np.ndarray) -> list[ev.Event]:
-        """The caregiver listens to the coming sound; she fetches the toy it names."""
+    def _hear(self, voice_formants: np.ndarray) -> list[ev.Event]:
+        """The caregiver listens to the coming sound, (n_steps, 2) log2 Hz; she fetches the toy
+        it names."""
         # Only the 5 sample steps make the sound features (protocol.md).
-        samples = actions[list(self.config.sample_indices), N_JOINTS:]
-        features = normalise(self.vocal_tract.formants(samples), self.vocal_tract.config)
-        word = self.vocal_tract.recognise(features)
+        samples = voice_formants[list(self.config.sample_indices)]
+        word = self.vocal_tract.recognise(normalise(samples, self.vocal_tract.config))
         if word is None:
             return []
         toy = self.words.toy_of(word)
@@ -206,15 +207,17 @@ class Playroom:
         self.words = WordAssignment(tuple(names), tuple(distractors))
 
     # The movement -------------------------------------------------------------------------
-    def _run(self, movement: str, actions: np.ndarray) -> Feedback:
+    def _run(
+        self, movement: str, actions: np.ndarray, voice_formants: np.ndarray | None = None
+    ) -> Feedback:
         p = self.physics
         saved = self.get_state()
         n = self.config.n_steps
         positions = np.empty((n + 1, len(TRACKED), 2))
         sound = np.zeros((n, 2))
         positions[0] = p.tracked_positions()
-        self.task.begin_movement(p, movement)
-        events = self._hear(actions) if movement == VOICE else []
+        self.task.begin_movement(p, movement, voice_formants)
+        events = self._hear(voice_formants) if movement == VOICE else []
         try:
             for k in range(n):
                 obs = self.env.step(actions[k]).observation

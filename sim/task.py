@@ -42,6 +42,7 @@ class PlayroomTask(control.Task):
         self.movement: str | None = None
         self.step_index = 0
         self.sound = np.zeros(2)
+        self._planned_sound: np.ndarray | None = None
         self.step_events: list[ev.Event] = []
 
     # dm_control interface -----------------------------------------------------------------
@@ -63,7 +64,10 @@ class PlayroomTask(control.Task):
         if self.movement == ARM:
             self.step_events += self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
         elif self.movement == VOICE:
-            self.sound = self._normalised(self.vocal_tract.formants(action[N_JOINTS:]))
+            if self._planned_sound is not None:
+                self.sound = self._planned_sound[self.step_index - 1]
+            else:
+                self.sound = self._normalised(self.vocal_tract.formants(action[N_JOINTS:]))
         self.caregiver.before_step(physics)
 
     def after_step(self, physics: PlayroomPhysics) -> None:
@@ -89,9 +93,16 @@ class PlayroomTask(control.Task):
         return 0.0
 
     # Movements ----------------------------------------------------------------------------
-    def begin_movement(self, physics: PlayroomPhysics, movement: str) -> None:
+    def begin_movement(
+        self, physics: PlayroomPhysics, movement: str, voice_formants: np.ndarray | None = None
+    ) -> None:
+        """Start a movement. voice_formants: (n_steps, 2) log2 Hz of the planned articulator
+        trajectory of a vocal movement. A formant depends only on the articulators of its own
+        frame, so the voice computes the whole movement in one vectorised call and the sensor
+        reads each step's frame; without it, each step's action is sent through the voice."""
         if movement not in (ARM, VOICE):
             raise ValueError(f"unknown movement {movement!r}: 'arm' or 'voice'")
+        self._planned_sound = None if voice_formants is None else self._normalised(voice_formants)
         self.movement = movement
         self.step_index = 0
         self.sound[:] = 0.0

@@ -77,14 +77,22 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2, help="processes for the exact path")
     parser.add_argument("--max-iter", type=int, default=3000, help="L-BFGS iterations of the MLP")
+    parser.add_argument(
+        "--words-only",
+        action="store_true",
+        help="keep the stored articulators and fast map; redo vowel targets and productions",
+    )
     args = parser.parse_args(argv)
     t_start = time.perf_counter()
     rng_art, rng_train, rng_test = np.random.default_rng(args.seed).spawn(3)
     cfg = DEFAULT_VOICE
 
     # 1. Articulators.
-    model = build_articulator_model(seed=int(rng_art.integers(2**31)))
-    model.save()
+    if args.words_only:
+        model = ArticulatorModel.load()
+    else:
+        model = build_articulator_model(seed=int(rng_art.integers(2**31)))
+        model.save()
     ev = model.explained_variance_ratio
     print("Articulators: 7 principal components of the speaker's tract shapes")
     print("  explained corpus variance per component:", np.round(ev, 4), f"(sum {ev.sum():.4f})")
@@ -104,35 +112,38 @@ def main(argv: list[str] | None = None) -> None:
         print(f"  /{name}/  {f1:7.0f} {f2:7.0f}   | {s1:7.0f} {s2:5.0f}")
 
     # 3. Fast formant map.
-    n_test = max(200, args.samples // 10)
-    x_train = sample_box(rng_train, args.samples)
-    x_test = rng_test.uniform(-1.0, 1.0, (n_test, 7))
-    t0 = time.perf_counter()
-    y_train, ok_train = exact_formants_parallel(model, x_train, args.workers, "exact (train)")
-    y_test, ok_test = exact_formants_parallel(model, x_test, args.workers, "exact (held-out)")
-    t_gen = time.perf_counter() - t0
-    print(
-        f"Exact path: {len(x_train) + n_test} articulations in {t_gen:.0f} s; "
-        f"fallbacks: {np.count_nonzero(~ok_train)} train, {np.count_nonzero(~ok_test)} held-out"
-    )
-    t0 = time.perf_counter()
-    fmap = fit_formant_map(
-        x_train[ok_train],
-        y_train[ok_train],
-        seed=args.seed,
-        max_iter=args.max_iter,
-        rounds=tqdm(range(ROUNDS), desc="MLP fit (L-BFGS)", unit="round"),
-    )
-    t_fit = time.perf_counter() - t0
-    # Evaluate and use the map as stored (float32 weights), exactly as the world will load it.
-    fmap.save()
-    fmap = FormantMap.load()
-    err = np.abs(fmap(x_test[ok_test]) - y_test[ok_test])
-    med, p95 = np.median(err, axis=0), np.percentile(err, 95, axis=0)
-    print(f"Fast map fitted in {t_fit:.0f} s. Held-out abs error (log2), F1 / F2:")
-    print(f"  median {med[0]:.4f} / {med[1]:.4f}   (target <= 0.02)")
-    print(f"  p95    {p95[0]:.4f} / {p95[1]:.4f}   (target <= 0.06)")
-    fmap.save(samples=args.samples, seed=args.seed, heldout_median=med, heldout_p95=p95)
+    if args.words_only:
+        fmap = FormantMap.load()
+    else:
+        n_test = max(200, args.samples // 10)
+        x_train = sample_box(rng_train, args.samples)
+        x_test = rng_test.uniform(-1.0, 1.0, (n_test, 7))
+        t0 = time.perf_counter()
+        y_train, ok_train = exact_formants_parallel(model, x_train, args.workers, "exact (train)")
+        y_test, ok_test = exact_formants_parallel(model, x_test, args.workers, "exact (held-out)")
+        t_gen = time.perf_counter() - t0
+        print(
+            f"Exact path: {len(x_train) + n_test} articulations in {t_gen:.0f} s; "
+            f"fallbacks: {np.count_nonzero(~ok_train)} train, {np.count_nonzero(~ok_test)} held-out"
+        )
+        t0 = time.perf_counter()
+        fmap = fit_formant_map(
+            x_train[ok_train],
+            y_train[ok_train],
+            seed=args.seed,
+            max_iter=args.max_iter,
+            rounds=tqdm(range(ROUNDS), desc="MLP fit (L-BFGS)", unit="round"),
+        )
+        t_fit = time.perf_counter() - t0
+        # Evaluate and use the map as stored (float32 weights), exactly as the world will load it.
+        fmap.save()
+        fmap = FormantMap.load()
+        err = np.abs(fmap(x_test[ok_test]) - y_test[ok_test])
+        med, p95 = np.median(err, axis=0), np.percentile(err, 95, axis=0)
+        print(f"Fast map fitted in {t_fit:.0f} s. Held-out abs error (log2), F1 / F2:")
+        print(f"  median {med[0]:.4f} / {med[1]:.4f}   (target <= 0.02)")
+        print(f"  p95    {p95[0]:.4f} / {p95[1]:.4f}   (target <= 0.06)")
+        fmap.save(samples=args.samples, seed=args.seed, heldout_median=med, heldout_p95=p95)
 
     # 4. Word productions, through the new fast map.
     tract = VocalTract(articulators=model, formant_map=fmap)
