@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections import Counter
 
@@ -186,6 +187,26 @@ def cmd_compare(args: argparse.Namespace) -> None:
         raise UsageError(str(exc)) from None
 
 
+def cmd_say(args: argparse.Namespace) -> None:
+    """A word as audio, from the voice parameters found to produce it."""
+    from pathlib import Path
+
+    from sim.vocal.audio import synthesise_word, write_wav
+    from sim.vocal.config import DEFAULT_VOICE
+    from sim.vocal.produce import stored_distances
+
+    if args.word not in DEFAULT_VOICE.words:
+        raise UsageError(f"unknown word {args.word!r}: one of {', '.join(DEFAULT_VOICE.words)}")
+    out = Path(args.out)
+    if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
+        raise UsageError(f"cannot write {out}: {out.parent} is not a writable directory")
+    waveform, rate = synthesise_word(args.word)
+    write_wav(out, waveform, rate)
+    distance = stored_distances()[args.word]
+    print(f"{out}: /{args.word}/, {len(waveform) / rate:.2f} s; its sound is {distance:.3f} from "
+          "the perfect word (recognised below 0.4)")  # fmt: skip
+
+
 def cmd_bench(args: argparse.Namespace) -> None:
     from experiments.bench import SECTIONS, run_bench
 
@@ -264,6 +285,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fps", type=float, default=50.0)
     p.add_argument("--camera", choices=["top", "hand_view"], default="top")
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("say", help="write a word as audio (WAV), from the agent's voice")
+    p.add_argument("word", help="one of the 6 words, e.g. oey")
+    p.add_argument("--out", required=True, help="the WAV file to write")
+    p.set_defaults(func=cmd_say)
 
     p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
     p.add_argument("section", nargs="*", help="sections to run (default: all)")
