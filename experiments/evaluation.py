@@ -107,7 +107,10 @@ def competence_table(
                 d_arm = agent.nearest_distance(arm_model, context, goal)
                 d_voice = agent.nearest_distance(voice_model, context, goal)
                 space, model = ("arm", arm_model) if d_arm <= d_voice else ("voice", voice_model)
-                feedback = _act(room, space, agent.exploit(model, context, goal))
+                untrained = not np.isfinite(min(d_arm, d_voice))
+                # A toy never moved has no model to invert: the arm stays at rest.
+                command = np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
+                feedback = _act(room, space, command)
                 stick_moved = np.abs(feedback.s[10:20] - np.repeat(context[:2], 5)).max() > 1e-3
                 error = float(np.linalg.norm(feedback.s[block] - goal))
                 room.set_state(scene)
@@ -127,6 +130,7 @@ def competence_table(
                         "arm_nn_distance": d_arm,
                         "voice_nn_distance": d_voice,
                         "strategy": strategy_of(space, bool(stick_moved)),
+                        "untrained": untrained,
                         "error": error,
                         "random_error": random_error,
                     }

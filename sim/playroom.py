@@ -121,7 +121,12 @@ class Playroom:
         articulators = voice_trajectory(m, self.config).T  # (n_steps, 7)
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = articulators
-        return self._run(VOICE, actions, self.vocal_tract.formants(articulators))
+        fallbacks = self.vocal_tract.n_fallbacks
+        formants = self.vocal_tract.formants(articulators)
+        feedback = self._run(VOICE, actions, formants)
+        if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
+            feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
+        return feedback
 
     def _hear(self, voice_formants: np.ndarray) -> list[ev.Event]:
         """The caregiver listens to the coming sound, (n_steps, 2) log2 Hz; she fetches the toy

@@ -1,0 +1,94 @@
+"""Evaluation after learning (protocol.md): goals, strategies, the random reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from experiments.cli import main
+from experiments.evaluation import (
+    GOAL_TIMES,
+    EvaluationSettings,
+    competence_table,
+    evaluate_trial,
+    goal_trajectory,
+    normalised_competence,
+    strategy_of,
+)
+from experiments.trial import TrialSettings, run_trial
+from sim import Playroom
+from sim.config import ARM_DIM
+
+
+class RestingAgent:
+    """A scripted agent whose outcome is known: its arm model is always nearer than its voice
+    model, and its command keeps the arm at rest, so no toy moves."""
+
+    def toy_models(self, toy: int) -> tuple[int, int]:
+        return 2 + toy - 1, 6 + toy - 1
+
+    def nearest_distance(self, model: int, context, goal) -> float:
+        return 0.1 if model < 6 else 0.9
+
+    def exploit(self, model: int, context, goal) -> np.ndarray:
+        return np.zeros(ARM_DIM)
+
+
+def test_goal_is_the_toy_moved_straight_to_the_base():
+    goal = goal_trajectory(np.array([0.4, -0.2]))
+    np.testing.assert_allclose(goal[:5], 0.4 * (1 - GOAL_TIMES))
+    np.testing.assert_allclose(goal[5:], -0.2 * (1 - GOAL_TIMES))
+    assert goal[4] == 0 and goal[9] == 0
+
+
+def test_strategy_classification():
+    assert strategy_of("voice", stick_moved=False) == "vocal"
+    assert strategy_of("voice", stick_moved=True) == "vocal"
+    assert strategy_of("arm", stick_moved=False) == "hand"
+    assert strategy_of("arm", stick_moved=True) == "tool"
+
+
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_scripted_agent_errors_match_a_hand_computation(grasp):
+    room = Playroom(grasp, seed=0)
+    table = competence_table(RestingAgent(), room, EvaluationSettings(n_placements=4, seed=9))
+    assert len(table) == 3 * 4 * 3
+    assert set(table["strategy"]) == {"hand"}
+    # A toy at p that does not move, against the goal p (1 - t): error = |p| sqrt(sum t^2),
+    # unless the resting hand (at (0, 0.5)) grabs it at once.
+    far_from_hand = np.hypot(table["x"], table["y"] - 0.5) > 0.15
+    expected = table["distance"] * np.sqrt(np.sum(GOAL_TIMES**2))
+    np.testing.assert_allclose(table["error"][far_from_hand], expected[far_from_hand], atol=1e-6)
+    # Rings hold their toys.
+    for ring, (low, high) in enumerate(room.config.toy_rings, start=1):
+        d = table[table["ring"] == ring]["distance"]
+        assert d.min() >= low and d.max() <= high
+
+
+def test_random_reference_is_seeded_and_normalisation_is_0_to_1():
+    room = Playroom("kinematic", seed=0)
+    settings = EvaluationSettings(n_placements=3, seed=4)
+    a = competence_table(RestingAgent(), room, settings)
+    b = competence_table(RestingAgent(), Playroom("kinematic", seed=0), settings)
+    pd.testing.assert_frame_equal(a, b)
+    assert (a["random_error"] > 0).all()
+    same = pd.DataFrame({"error": [1.0, 2.0], "random_error": [1.0, 2.0]})
+    perfect = pd.DataFrame({"error": [0.0, 0.0], "random_error": [1.0, 2.0]})
+    assert normalised_competence(same) == 0.0 and normalised_competence(perfect) == 1.0
+
+
+def test_eval_of_a_trial_writes_its_files_and_leaves_the_trial_unchanged(tmp_path, capsys):
+    trial = tmp_path / "t"
+    run_trial(trial, TrialSettings(iterations=60, seed=0, checkpoint_every=60), progress=False)
+    checkpoint = (trial / "checkpoint.npz").read_bytes()
+    summary = evaluate_trial(trial, EvaluationSettings(n_placements=2))
+    assert set(summary["competence"]) == {"all", "ring1", "ring2", "ring3"}
+    assert len(summary["vocal"]["best_distance"]) == 6 and len(summary["vocal"]["names"]) == 3
+    for name in ("eval.json", "competence.parquet", "vocal.parquet"):
+        assert (trial / name).exists()
+    assert (trial / "checkpoint.npz").read_bytes() == checkpoint
+    assert main(["eval", str(trial), "--placements", "2", "--quiet"]) == 0
+    assert "normalised competence" in capsys.readouterr().out
+    assert main(["eval", str(tmp_path / "nothing")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
