@@ -9,6 +9,8 @@ import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
+from sim.config import DEFAULT_WORLD
+
 MODEL_PATH = Path(__file__).resolve().parent.parent / "models" / "playroom.xml"
 
 TOYS = ("toy1", "toy2", "toy3")
@@ -83,7 +85,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
 
     def hand_angle(self) -> float:
         """Orientation of the last segment in the plane (rad), as the protocol defines it."""
-        return float(self.arm_angles().sum() + np.pi / 2)
+        return float(self.arm_angles().sum() + DEFAULT_WORLD.arm_rest_offset)
 
     def arm_angles(self) -> np.ndarray:
         """(3,) joint angles relative to rest (rad)."""
