@@ -214,8 +214,12 @@ def run_batch(
             except Exception as exc:  # a trial's error must not stop the others
                 failures[name] = f"{type(exc).__name__}: {exc}"
             bar.update(1)
-            running = sum(not f.done() for f in futures)
-            bar.set_postfix(done=len(results), running=running, failed=len(failures))
+            # Tasks on a worker now; the rest of the unfinished ones wait in the queue.
+            running = sum(len(keys) for keys in client.processing().values())
+            waiting = sum(not f.done() for f in futures) - running
+            bar.set_postfix(
+                done=len(results), running=running, waiting=waiting, failed=len(failures)
+            )
         bar.close()
     finally:
         if own_cluster is not None:

@@ -25,6 +25,8 @@ class Caregiver:
         self.physical = physical
         self.config = config
         self.bringing: int | None = None  # index of the toy she is bringing
+        self._collision_bits = (0, 0)  # contype, conaffinity of the toy she carries
+        self._damping = np.zeros(3)  # its joints' damping on the table
 
     def place(self, physics: PlayroomPhysics, rng: np.random.Generator) -> None:
         """A new position, uniform in the square [-box, box]^2."""
@@ -55,6 +57,14 @@ class Caregiver:
         m.eq_data[eq, 3:6] = d.xpos[body] - d.mocap_pos[hand]
         m.eq_data[eq, 6:10] = (1.0, 0.0, 0.0, 0.0)
         d.eq_active[eq] = 1
+        # She lifts the toy: while carried it touches nothing, as a toy carried above the
+        # table would not (dragged along the table it would sweep the stick out of reach).
+        geom = physics.toy_geoms[toy]
+        self._collision_bits = (int(m.geom_contype[geom]), int(m.geom_conaffinity[geom]))
+        m.geom_contype[geom] = m.geom_conaffinity[geom] = 0
+        dofs = physics.object_dof[1 + toy]
+        self._damping = m.dof_damping[dofs].copy()
+        m.dof_damping[dofs] = 0.0  # no table friction above the table
 
     def before_step(self, physics: PlayroomPhysics) -> None:
         """Move the toy she is bringing `bring_rate` of the remaining way."""
@@ -81,6 +91,9 @@ class Caregiver:
                 m, mujoco.mjtObj.mjOBJ_EQUALITY, f"caregiver_{TOYS[self.bringing]}"
             )
             d.eq_active[eq] = 0
+            geom = physics.toy_geoms[self.bringing]
+            m.geom_contype[geom], m.geom_conaffinity[geom] = self._collision_bits
+            m.dof_damping[physics.object_dof[1 + self.bringing]] = self._damping
             d.qvel[physics.object_dof] = 0.0
             d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
         self.bringing = None

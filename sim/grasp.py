@@ -163,6 +163,7 @@ class PhysicalGrasp(GraspBackend):
         super().begin(physics)
         if self._base_conaffinity is None:
             self._base_conaffinity = physics.model.ptr.geom_conaffinity.copy()
+            self._base_damping = physics.model.ptr.dof_damping.copy()
             self._weld_ids = self._welds(physics)
 
     def before_step(
@@ -221,6 +222,9 @@ class PhysicalGrasp(GraspBackend):
         m.eq_data[eq, 3:6] = rel_pos
         m.eq_data[eq, 6:10] = rel_quat
         d.eq_active[eq] = 1
+        # The held object is lifted off the table: no table friction while it is carried.
+        row = physics.object_bodies.tolist().index(b2)
+        m.dof_damping[physics.object_dof[row]] = 0.0
 
     def _filter_collisions(self, physics: PlayroomPhysics) -> None:
         """Stop each held object from colliding with what holds it, and only with that.
@@ -251,6 +255,7 @@ class PhysicalGrasp(GraspBackend):
         self.hand_holds = None
         self.stick_holds = None
         physics.model.ptr.geom_conaffinity[:] = self._base_conaffinity
+        physics.model.ptr.dof_damping[:] = self._base_damping
         d.qvel[physics.object_dof] = 0.0
         _arm_to_rest(physics)
 

@@ -52,6 +52,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self.toy_geoms = np.array([geom(t) for t in TOYS])
         self.toy_bodies = np.array([body(t) for t in TOYS])
         self.stick_body = body("stick")
+        self.object_bodies = np.array([body(o) for o in OBJECTS])
         self.hand_body = body("hand_link")
         self.caregiver_mocap = m.body_mocapid[body("caregiver")]
         self.caregiver_hand_mocap = m.body_mocapid[body("caregiver_hand")]
