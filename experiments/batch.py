@@ -214,9 +214,11 @@ def run_batch(
             except Exception as exc:  # a trial's error must not stop the others
                 failures[name] = f"{type(exc).__name__}: {exc}"
             bar.update(1)
-            # Tasks on a worker now; the rest of the unfinished ones wait in the queue.
-            running = sum(len(keys) for keys in client.processing().values())
-            waiting = sum(not f.done() for f in futures) - running
+            # Dask may queue more tasks on a worker than it has threads: at most one task per
+            # thread runs, the rest of the unfinished ones wait.
+            unfinished = sum(not f.done() for f in futures)
+            running = min(unfinished, sum(client.nthreads().values()))
+            waiting = unfinished - running
             bar.set_postfix(
                 done=len(results), running=running, waiting=waiting, failed=len(failures)
             )
