@@ -299,7 +299,8 @@ class Playroom:
         p = self.physics
         m = p.model.ptr
         toy_radius = m.geom_size[p.toy_geoms[0], 0]
-        stick_radius = m.geom_rbound[p.stick_geoms].max()
+        # The thickest part of the stick (its tip sphere), measured from the handle-tip line.
+        stick_radius = m.geom_size[p.stick_geoms, 0].max()
         for j in range(toy):
             if np.linalg.norm(position - poses[1 + j, :2]) < 2 * toy_radius + PLACEMENT_CLEARANCE:
                 return False
