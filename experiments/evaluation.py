@@ -28,7 +28,8 @@ from experiments import storage
 from experiments.trial import load_trial
 from learner.agent import Agent
 from sim import Playroom
-from sim.config import ARM_DIM, VOICE_DIM
+from sim.config import ARM_DIM, SENSORY_BLOCKS, VOICE_DIM
+from sim.playroom import MOVE_TOLERANCE as MOVED
 from sim.playroom import PLACEMENT_CLEARANCE
 from sim.vocal.config import DEFAULT_VOICE
 
@@ -41,7 +42,7 @@ GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
 # that trials are compared on identical tests.
 EVAL_SEED = 20170000
 # Toys of one placement keep this far apart (m): two solid toys cannot overlap.
-MIN_TOY_GAP = 2 * 0.035 + PLACEMENT_CLEARANCE
+MIN_TOY_GAP = 2 * 0.035 + PLACEMENT_CLEARANCE  # 0.035 m: the toys' radius in the MJCF
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ def competence_table(
             context = room.context()
             for toy in range(3):
                 goal = goal_trajectory(toys_of[p, toy])
-                block = slice(20 + 10 * toy, 30 + 10 * toy)
+                block = SENSORY_BLOCKS[f"toy{toy + 1}"]
                 arm_model, voice_model = agent.toy_models(toy + 1)
                 d_arm = agent.nearest_distance(arm_model, context, goal)
                 d_voice = agent.nearest_distance(voice_model, context, goal)
@@ -111,7 +112,8 @@ def competence_table(
                 # A toy never moved has no model to invert: the arm stays at rest.
                 command = np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
                 feedback = _act(room, space, command)
-                stick_moved = np.abs(feedback.s[10:20] - np.repeat(context[:2], 5)).max() > 1e-3
+                stick = feedback.s[SENSORY_BLOCKS["stick"]]  # 5 x then 5 y
+                stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED
                 error = float(np.linalg.norm(feedback.s[block] - goal))
                 room.set_state(scene)
                 random_space = "arm" if rng.random() < 0.5 else "voice"
