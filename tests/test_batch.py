@@ -129,3 +129,12 @@ def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "no Dask scheduler answered" in err and len(err.strip().splitlines()) == 1
     assert not any(Path(tmp_path / "b").glob("*/config.json"))
+
+
+def test_stored_profiles_hold_what_the_readme_says():
+    smoke, demo, paper = (load_spec(p) for p in ("smoke", "demo", "paper"))
+    assert len(smoke.trials()) == 4 and smoke.iterations <= 500
+    assert set(demo.grasps) == {"kinematic", "physical"} and len(demo.trials()) == 8
+    assert demo.iterations == 20000
+    assert len(paper.seeds) == 500 and paper.iterations == 80000 and len(paper.trials()) == 1000
+    assert paper.eval_placements == 100

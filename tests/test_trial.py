@@ -56,8 +56,9 @@ def test_run_writes_config_checkpoint_and_logs(tmp_path, grasp):
     assert meta["iteration"] == 120 and meta["finished"]
 
 
-def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path):
-    args = ["run", "--grasp", "kinematic", "--iterations", "1500", "--seed", "4"]
+@pytest.mark.parametrize("grasp", ["kinematic", pytest.param("physical", marks=pytest.mark.slow)])
+def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path, grasp):
+    args = ["run", "--grasp", grasp, "--iterations", "1500", "--seed", "4"]
     args += ["--checkpoint-every", "200", "--quiet"]
     whole = tmp_path / "whole"
     assert _run_cli(*args, "--out", str(whole)).returncode == 0
