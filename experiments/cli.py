@@ -156,8 +156,8 @@ def cmd_render(args: argparse.Namespace) -> None:
             size=args.size, fps=args.fps, camera=args.camera,
         )  # fmt: skip
     except (ValueError, RenderError, ReplayError) as exc:
-        raise UsageError(f"{exc} (offscreen rendering needs EGL; try MUJOCO_GL=osmesa)"
-                         if isinstance(exc, RenderError) else str(exc)) from None  # fmt: skip
+        # A RenderError names the fallback itself (MUJOCO_GL=osmesa) when EGL is missing.
+        raise UsageError(str(exc)) from None
     for r in replayed:
         verdict = "events as logged" if r.matches else "DIFFERS from the log"
         print(f"  iteration {r.iteration}: replayed {verdict}")
