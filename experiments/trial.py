@@ -150,15 +150,14 @@ class Trial:
 
     # Checkpoints --------------------------------------------------------------------------
     def _save_checkpoint(self) -> None:
-        agent_arrays, agent_meta = _split_state(self.agent.state_dict())
         room_state = self.room.get_state()
-        arrays = {f"agent/{k}": v for k, v in agent_arrays.items()}
+        # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
+        arrays = {f"agent/{k}": v for k, v in self.agent.state_dict().items()}
         arrays["room/physics"] = room_state.pop("physics")
         arrays["best_word_distance"] = self.best_word_distance
         meta = {
             "iteration": self.iteration,
             "finished": self.finished,
-            "agent": agent_meta,
             "room": room_state,
             "counts": self.counts,
         }
@@ -281,10 +280,9 @@ def restore_checkpoint(trial_dir: str | os.PathLike, agent: Agent, room: Playroo
     path = Path(trial_dir) / CHECKPOINT_FILE
     arrays, meta = storage.read_arrays(path)
     try:
-        agent_state = dict(meta["agent"])
-        agent_state.update(
-            {k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")}
-        )
+        agent_state = {
+            k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")
+        }
         agent.load_state_dict(agent_state)
         room.set_state({**meta["room"], "physics": arrays["room/physics"]})
         meta["best_word_distance"] = arrays["best_word_distance"].copy()
@@ -304,23 +302,6 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
     agent, room = fresh_trial_parts(config)
     meta = restore_checkpoint(trial_dir, agent, room)
     return config, agent, room, meta
-
-
-def _split_state(state: dict) -> tuple[dict[str, np.ndarray], dict]:
-    """Arrays go to the .npz file, everything else (numbers, generator states) to JSON."""
-    arrays = {k: v for k, v in state.items() if isinstance(v, np.ndarray)}
-    meta = {k: _jsonable(v) for k, v in state.items() if not isinstance(v, np.ndarray)}
-    return arrays, meta
-
-
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {k: _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
 
 
 def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:

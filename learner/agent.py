@@ -113,13 +113,7 @@ class Agent:
         if proposal is not self._pending:
             raise ValueError("learn() takes the proposal returned by the last propose()")
         context = self._check_context(context)
-        s = np.asarray(s, dtype=np.float64)
-        if s.shape != (self.config.sensory_dim,):
-            raise ValueError(
-                f"feedback s must have shape ({self.config.sensory_dim},), got {s.shape}"
-            )
-        if not np.isfinite(s).all():
-            raise ValueError("feedback s has a NaN or infinite value")
+        s = _checked_vector(s, self.config.sensory_dim, "feedback s")
         m = proposal.m
         for k in self._by_space[proposal.motor_space]:
             self.models[k].update(m, context, s)
@@ -230,14 +224,17 @@ class Agent:
         return sounds[self.rng.integers(len(sounds))].copy()
 
     def _check_context(self, context: ArrayLike) -> np.ndarray:
-        context = np.asarray(context, dtype=np.float64)
-        if context.shape != (self.config.context_dim,):
-            raise ValueError(
-                f"context must have shape ({self.config.context_dim},), got {context.shape}"
-            )
-        if not np.isfinite(context).all():
-            raise ValueError("context has a NaN or infinite value")
-        return context
+        return _checked_vector(context, self.config.context_dim, "context")
+
+
+def _checked_vector(value: ArrayLike, dim: int, what: str) -> np.ndarray:
+    """`value` as a finite float64 vector of shape (dim,), or ValueError naming `what`."""
+    vector = np.asarray(value, dtype=np.float64)
+    if vector.shape != (dim,):
+        raise ValueError(f"{what} must have shape ({dim},), got {vector.shape}")
+    if not np.isfinite(vector).all():
+        raise ValueError(f"{what} has a NaN or infinite value")
+    return vector
 
 
 def _jsonable(value: Any) -> Any:

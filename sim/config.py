@@ -36,10 +36,6 @@ class WorldConfig:
     caregiver_bring_rate: float = 0.01
 
     @property
-    def arm_length(self) -> float:
-        return float(sum(self.segment_lengths))
-
-    @property
     def sample_indices(self) -> tuple[int, ...]:
         """0-based indices into a 50-step trajectory of the 5 sample steps."""
         return tuple(s - 1 for s in self.sample_steps)

@@ -37,12 +37,3 @@ class Event:
     obj: str | None = None
     by: str | None = None
     word: str | None = None
-
-    def as_dict(self) -> dict:
-        return {
-            "kind": self.kind,
-            "step": self.step,
-            "obj": self.obj,
-            "by": self.by,
-            "word": self.word,
-        }

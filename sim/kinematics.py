@@ -20,8 +20,3 @@ def hand_positions(joint_angles: np.ndarray, config: WorldConfig = DEFAULT_WORLD
     x = (lengths * np.cos(absolute)).sum(axis=0)
     y = (lengths * np.sin(absolute)).sum(axis=0)
     return np.stack([x, y], axis=-1)
-
-
-def hand_angles(joint_angles: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
-    """(3, ...) joint angles -> (...) orientation of the last segment (rad)."""
-    return np.sum(np.asarray(joint_angles, dtype=float), axis=0) + config.arm_rest_offset

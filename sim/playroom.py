@@ -17,7 +17,7 @@ from sim.grasp import BACKENDS, make_backend
 from sim.physics import CONTROL_SUBSTEPS, TOYS, KinematicPhysics, PlayroomPhysics
 from sim.task import ARM, N_ARTICULATORS, N_JOINTS, VOICE, PlayroomTask
 from sim.vocal.tract import VocalTract
-from sim.vocal.words import WordAssignment, assign_words, normalise, word_features
+from sim.vocal.words import WordAssignment, assign_words, word_features
 
 # An object counts as moved once it is this far from where it started (m). Contacts of
 # resting objects jitter by far less.
@@ -118,11 +118,11 @@ class Playroom:
         during the same 50 steps, as in the study.
         """
         m = _checked_command(m, VOICE_DIM, "voice command")
-        articulators = voice_trajectory(m, self.config).T  # (n_steps, 7)
+        articulators = voice_trajectory(m, self.config)  # (7, n_steps)
         actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
-        actions[:, N_JOINTS:] = articulators
+        actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
-        formants = self.vocal_tract.formants(articulators)
+        formants = self.vocal_tract.trajectory_formants(articulators)
         feedback = self._run(VOICE, actions, formants)
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
@@ -131,9 +131,7 @@ class Playroom:
     def _hear(self, voice_formants: np.ndarray) -> list[ev.Event]:
         """The caregiver listens to the coming sound, (n_steps, 2) log2 Hz; she fetches the toy
         it names."""
-        # Only the 5 sample steps make the sound features (protocol.md).
-        samples = voice_formants[list(self.config.sample_indices)]
-        word = self.vocal_tract.recognise(normalise(samples, self.vocal_tract.config))
+        word = self.vocal_tract.recognise(self.vocal_tract.features_from_formants(voice_formants))
         if word is None:
             return []
         toy = self.words.toy_of(word)

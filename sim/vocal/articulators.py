@@ -71,11 +71,6 @@ class ArticulatorModel:
         z = self.mean + (artic * self.scales) @ self.components
         return np.clip(self.lo + (self.hi - self.lo) * z, self.lo, self.hi)
 
-    def to_articulators(self, tract: np.ndarray) -> np.ndarray:
-        """Tract states (..., 19) -> articulator values (..., 7) of their projection (unclipped)."""
-        z = (np.asarray(tract, dtype=float) - self.lo) / (self.hi - self.lo)
-        return ((z - self.mean) @ self.components.T) / self.scales
-
     def vowel(self, name: str) -> np.ndarray:
         """(7,) articulator values of one study vowel."""
         return self.vowel_articulators[self.vowel_names.index(name)].copy()

@@ -34,10 +34,6 @@ class VoiceConfig:
         """Points of a word's trajectory: v1, mid(v1, v2), v2, mid(v2, v3), v3."""
         return 5
 
-    @property
-    def feature_dim(self) -> int:
-        return 2 * self.n_points
-
     def study_hz(self, vowel: str) -> tuple[float, float]:
         """The study's (F1, F2) in Hz for one vowel."""
         for name, f1, f2 in self.study_vowel_hz:
