@@ -1,10 +1,5 @@
 """Experiments: the command line, trials, evaluation, batches, reports, videos, bench.
 
-MuJoCo picks its OpenGL backend when it is first imported, so the project's offscreen default
-(EGL, which also works without a GPU through Mesa) is set here, before any module imports it.
-Set MUJOCO_GL=osmesa in the environment to use OSMesa instead.
+Importing it changes nothing in the process: the `playroom` command chooses MuJoCo's OpenGL
+backend per command (experiments/gl.py), before anything imports mujoco.
 """
-
-import os
-
-os.environ.setdefault("MUJOCO_GL", "egl")

@@ -23,12 +23,16 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
+from experiments.lock import DirectoryLock
 from experiments.trial import CHECKPOINT_FILE, TrialSettings, run_trial
 
 PROFILES = ("smoke", "demo", "paper")
 TIMING_FILE = "timing.json"
 # How long to wait for a scheduler that does not answer.
 CONNECT_TIMEOUT_S = 10
+# How long a batch task waits for another writer of its trial to finish (s): longer than a
+# trial of the paper profile takes on one core.
+LOCK_WAIT_S = 4 * 3600
 
 
 class BatchError(Exception):
@@ -123,17 +127,26 @@ def is_complete(trial_dir: Path) -> bool:
 def run_and_evaluate(trial_dir: str, settings: TrialSettings, eval_placements: int) -> dict:
     """One batch task: run or resume the trial, then evaluate it. Safe to run again."""
     path = Path(trial_dir)
-    resume = (path / "config.json").exists()
-    start = time.perf_counter()
-    trial = run_trial(path, settings, resume=resume, progress=False)
-    if trial.elapsed is not None:
-        # Only the iterations run now are timed, so resumed trials still give a fair cost.
-        storage.write_json(
-            path / TIMING_FILE,
-            {"seconds": trial.elapsed, "iterations": settings.iterations - trial.start_iteration},
-        )
-    summary = evaluate_trial(path, EvaluationSettings(n_placements=eval_placements))
-    summary["wall_seconds"] = time.perf_counter() - start
+    # Dask may run a task again while its first attempt still runs on a worker it lost touch
+    # with: the second waits for the first to end instead of writing beside it.
+    lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
+    try:
+        resume = (path / "config.json").exists()
+        start = time.perf_counter()
+        trial = run_trial(path, settings, resume=resume, progress=False)
+        if trial.elapsed is not None:
+            # Only the iterations run now are timed, so resumed trials still give a fair cost.
+            storage.write_json(
+                path / TIMING_FILE,
+                {
+                    "seconds": trial.elapsed,
+                    "iterations": settings.iterations - trial.start_iteration,
+                },
+            )
+        summary = evaluate_trial(path, EvaluationSettings(n_placements=eval_placements))
+        summary["wall_seconds"] = time.perf_counter() - start
+    finally:
+        lock.release()
     return summary
 
 

@@ -12,7 +12,6 @@ from collections.abc import Callable, Iterator
 import mujoco
 import numpy as np
 
-from experiments.video import render_figures
 from sim import Playroom
 from sim.config import ARM_DIM, DEFAULT_WORLD
 from sim.physics import CONTROL_SUBSTEPS
@@ -136,6 +135,13 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
         80000 / (iterations / elapsed) / 60,
         ("min (target < 5)"),
     )
+
+
+def render_figures() -> Iterator[tuple[str, float, str]]:
+    """Offscreen rendering speed (needs an OpenGL backend: the CLI chooses it first)."""
+    from experiments import video
+
+    yield from video.render_figures()
 
 
 def _peak_rss_mb() -> float:

@@ -64,7 +64,13 @@ def cmd_run(args: argparse.Namespace) -> None:
             babbling=args.babbling,
             checkpoint_every=args.checkpoint_every,
         )
-        trial = run_trial(args.out, settings, resume=args.resume, progress=not args.quiet)
+        trial = run_trial(
+            args.out,
+            settings,
+            resume=args.resume,
+            progress=not args.quiet,
+            notify=lambda line: print(f"playroom run: {line}", file=sys.stderr, flush=True),
+        )
     except (TrialError, storage.CorruptFileError) as exc:
         raise UsageError(str(exc)) from None
     c = trial.counts
@@ -131,6 +137,12 @@ def _iteration_list(text: str) -> list[int]:
 
 def cmd_render(args: argparse.Namespace) -> None:
     """An MP4 of a trial's iterations (replayed exactly), or of random commands."""
+    from experiments import gl
+
+    try:
+        gl.for_rendering()  # before anything imports mujoco
+    except gl.GLError as exc:
+        raise UsageError(str(exc)) from None
     from experiments.replay import ReplayError, render_trial
     from experiments.video import RenderError, render_random
     from sim.dmp import voice_trajectory
@@ -156,7 +168,6 @@ def cmd_render(args: argparse.Namespace) -> None:
             size=args.size, fps=args.fps, camera=args.camera,
         )  # fmt: skip
     except (ValueError, RenderError, ReplayError) as exc:
-        # A RenderError names the fallback itself (MUJOCO_GL=osmesa) when EGL is missing.
         raise UsageError(str(exc)) from None
     for r in replayed:
         verdict = "events as logged" if r.matches else "DIFFERS from the log"
@@ -208,12 +219,28 @@ def cmd_say(args: argparse.Namespace) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> None:
+    from experiments import gl
+
+    sections = args.section or None
+    render_skipped = False
+    if sections is None or "render" in sections:
+        try:
+            gl.for_rendering()  # before anything imports mujoco
+        except gl.GLError as exc:
+            if sections is not None:
+                raise UsageError(str(exc)) from None
+            print(f"render: skipped ({exc})", flush=True)
+            render_skipped = True
+    else:
+        gl.without_rendering()
     from experiments.bench import SECTIONS, run_bench
 
     unknown = [s for s in args.section if s not in SECTIONS]
     if unknown:
         raise UsageError(f"unknown bench section(s) {unknown}: choose from {sorted(SECTIONS)}")
-    run_bench(args.section or None)
+    if render_skipped:
+        sections = [s for s in SECTIONS if s != "render"]
+    run_bench(sections)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -297,9 +324,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Commands that render choose an OpenGL backend themselves; the others load none.
+RENDERING_COMMANDS = ("render", "bench")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.command not in RENDERING_COMMANDS:
+        from experiments import gl
+
+        gl.without_rendering()
     try:
         args.func(args)
     except UsageError as exc:

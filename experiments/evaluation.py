@@ -25,7 +25,8 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import storage
-from experiments.trial import load_trial
+from experiments.lock import DirectoryLock, DirectoryLocked
+from experiments.trial import TrialLocked, load_trial
 from learner.agent import Agent
 from sim import Playroom
 from sim.config import ARM_DIM, SENSORY_BLOCKS, VOICE_DIM
@@ -196,12 +197,20 @@ def evaluate_trial(
     settings = settings or EvaluationSettings()
     trial_dir = Path(trial_dir)
     config, agent, room, meta = load_trial(trial_dir)
-    competence = competence_table(agent, room, settings, progress=progress)
-    vocal = vocal_table(meta["best_word_distance"], room.words.names)
-    summary = summarise(config, competence, vocal)
-    summary["evaluated_at_iteration"] = int(meta["iteration"])
-    summary["n_placements"] = settings.n_placements
-    storage.write_table(trial_dir / COMPETENCE_FILE, competence)
-    storage.write_table(trial_dir / VOCAL_FILE, vocal)
-    storage.write_json(trial_dir / EVAL_FILE, summary)
+    # Evaluation writes into the trial directory: one writer at a time, as for the trial.
+    try:
+        lock = DirectoryLock(trial_dir).acquire()
+    except DirectoryLocked as exc:
+        raise TrialLocked(str(exc)) from None
+    try:
+        competence = competence_table(agent, room, settings, progress=progress)
+        vocal = vocal_table(meta["best_word_distance"], room.words.names)
+        summary = summarise(config, competence, vocal)
+        summary["evaluated_at_iteration"] = int(meta["iteration"])
+        summary["n_placements"] = settings.n_placements
+        storage.write_table(trial_dir / COMPETENCE_FILE, competence)
+        storage.write_table(trial_dir / VOCAL_FILE, vocal)
+        storage.write_json(trial_dir / EVAL_FILE, summary)
+    finally:
+        lock.release()
     return summary

@@ -4,7 +4,8 @@ survives being killed.
 A trial directory holds:
 - `config.json`: every setting (trial, world, voice, learner), the package version, the seed;
 - `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
-  every `checkpoint_every` iterations and at the end;
+  every `checkpoint_every` iterations and at the end, with the one before it kept beside it
+  as `checkpoint.prev.npz`: a damaged newest checkpoint costs at most two periods;
 - `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
   one file per checkpoint period, starting at iteration NNNNNNNN;
 - `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
@@ -12,6 +13,11 @@ A trial directory holds:
 Each file is written atomically, and a log chunk is always written before the checkpoint that
 covers it, so a run killed at any moment resumes from its last checkpoint and rewrites the same
 chunks: the final memory and logs equal those of an uninterrupted run.
+
+One process writes into a trial directory at a time (experiments/lock.py). Resuming with more
+iterations than the trial was asked for extends it: the result equals a run asked for the
+larger number from the start, and files derived from the shorter run (its evaluation) are
+moved aside into `stale-at-NNNNNNNN/`.
 """
 
 from __future__ import annotations
@@ -19,7 +25,9 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import shutil
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.metadata import version
 from pathlib import Path
@@ -29,6 +37,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import storage
+from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
 from learner.agent import Agent
 from learner.config import LearnerConfig
 from sim import Playroom
@@ -40,7 +49,21 @@ from sim.vocal.words import word_distances
 
 CONFIG_FILE = "config.json"
 CHECKPOINT_FILE = "checkpoint.npz"
+PREVIOUS_CHECKPOINT_FILE = "checkpoint.prev.npz"
+# Where a damaged newest checkpoint is kept when a resume falls back past it.
+DAMAGED_CHECKPOINT_FILE = "checkpoint.damaged.npz"
 LOG_DIR = "log"
+# What a trial directory holds of the trial itself; everything else in it (evaluation, timing,
+# videos) was derived from the trial at some iteration and goes stale when it is extended.
+TRIAL_ENTRIES = (
+    CONFIG_FILE,
+    CHECKPOINT_FILE,
+    PREVIOUS_CHECKPOINT_FILE,
+    DAMAGED_CHECKPOINT_FILE,
+    LOG_DIR,
+    LOCK_FILE,
+)
+STALE_PREFIX = "stale-at-"
 # Iterations between two rows of the words log (issue 4: "every 100 iterations").
 WORDS_LOG_PERIOD = 100
 # The agent's random generator is seeded apart from the room's, from the same trial seed.
@@ -86,39 +109,72 @@ def full_config(settings: TrialSettings, learner: LearnerConfig | None = None) -
     return json.loads(json.dumps(config))
 
 
-def _config_differences(a: dict, b: dict, prefix: str = "") -> list[str]:
-    keys = sorted(set(a) | set(b))
+# Settings a resume may change: a trial can be extended to more iterations.
+EXTENSIBLE = ("trial.iterations",)
+
+
+def _config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, object, object]]:
+    """(dotted key, value in a, value in b) of every setting where two configs differ."""
     out = []
-    for k in keys:
+    for k in sorted(set(a) | set(b)):
         va, vb = a.get(k), b.get(k)
         if isinstance(va, dict) and isinstance(vb, dict):
             out += _config_differences(va, vb, f"{prefix}{k}.")
         elif va != vb:
-            out.append(f"{prefix}{k}: {va!r} != {vb!r}")
+            out.append((f"{prefix}{k}", va, vb))
     return out
 
 
+class TrialLocked(TrialError):
+    """Another process is writing into the trial directory."""
+
+
 class Trial:
-    """A trial directory and the loop that fills it."""
+    """A trial directory and the loop that fills it. It holds the directory's lock from its
+    creation until `close` (or the end of the process)."""
 
     def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
         self.dir = Path(out_dir)
         self.settings = settings
         self.config = full_config(settings)
-        self._check_directory(resume)
-        self.agent, self.room = fresh_trial_parts(self.config)
-        self.iteration = 0
-        self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
-        self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
-        self.elapsed: float | None = None  # seconds of the last `run_trial`
-        if resume and (self.dir / CHECKPOINT_FILE).exists():
-            self._load_checkpoint()
+        self.notices: list[str] = []  # one line each: what a resume had to do
+        self._refuse_foreign_path()
+        try:
+            self._lock = DirectoryLock(self.dir).acquire()
+        except DirectoryLocked as exc:
+            raise TrialLocked(str(exc)) from None
+        except OSError as exc:
+            raise TrialError(f"cannot write into {self.dir}: {exc.strerror}") from None
+        try:
+            self._check_directory(resume)
+            self.agent, self.room = fresh_trial_parts(self.config)
+            self.iteration = 0
+            self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
+            self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
+            self.elapsed: float | None = None  # seconds of the last `run_trial`
+            self.start_iteration = 0
+            if resume:
+                self._resume()
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Give up the directory's lock."""
+        self._lock.release()
 
     # Directory rules ----------------------------------------------------------------------
-    def _check_directory(self, resume: bool) -> None:
+    def _refuse_foreign_path(self) -> None:
+        """Before anything is written: a file, or a folder of something else, is refused."""
         d = self.dir
         if d.exists() and not d.is_dir():
             raise TrialError(f"{d} is a file, not a directory")
+        if d.is_dir() and not (d / CONFIG_FILE).exists():
+            if any(p.name != LOCK_FILE for p in d.iterdir()):
+                raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
+
+    def _check_directory(self, resume: bool) -> None:
+        d = self.dir
         config_path = d / CONFIG_FILE
         if config_path.exists():
             if not resume:
@@ -126,14 +182,16 @@ class Trial:
                     f"{d} already holds a trial; add --resume to continue it, or choose a new "
                     "directory"
                 )
-            diff = _config_differences(storage.read_json(config_path), self.config)
+            diff = [
+                f"{key}: {a!r} != {b!r}"
+                for key, a, b in _config_differences(storage.read_json(config_path), self.config)
+                if key not in EXTENSIBLE
+            ]
             if diff:
                 raise TrialError(
                     f"{d} holds a trial of another configuration ({'; '.join(diff[:4])}); "
                     "refusing to mix them"
                 )
-        elif d.exists() and any(d.iterdir()):
-            raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
         try:
             (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
             probe = d / ".write-test"
@@ -161,17 +219,64 @@ class Trial:
             "room": room_state,
             "counts": self.counts,
         }
-        storage.write_arrays(self.dir / CHECKPOINT_FILE, arrays, meta)
+        newest = self.dir / CHECKPOINT_FILE
+        if newest.exists():
+            # Killed between these two lines, the trial still has the previous checkpoint.
+            os.replace(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
+        storage.write_arrays(newest, arrays, meta)
 
-    def _load_checkpoint(self) -> None:
-        meta = restore_checkpoint(self.dir, self.agent, self.room)
-        self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
-        self.iteration = int(meta["iteration"])
-        self.counts = dict(meta["counts"])
+    def _resume(self) -> None:
+        """Load the newest readable checkpoint, drop the logs past it, and extend the trial
+        if more iterations are asked for than it was run with."""
+        newest = self.dir / CHECKPOINT_FILE
+        previous = self.dir / PREVIOUS_CHECKPOINT_FILE
+        if newest.exists() or previous.exists():
+            try:
+                meta = restore_checkpoint(self.dir, self.agent, self.room)
+            except storage.CorruptFileError as exc:
+                if not previous.exists():
+                    raise
+                # A restore that failed half-way may have changed them: start from fresh parts.
+                self.agent, self.room = fresh_trial_parts(self.config)
+                meta = restore_checkpoint(self.dir, self.agent, self.room, PREVIOUS_CHECKPOINT_FILE)
+                if newest.exists():
+                    os.replace(newest, self.dir / DAMAGED_CHECKPOINT_FILE)
+                self.notices.append(
+                    f"{exc}; resumed from the previous checkpoint, at iteration "
+                    f"{meta['iteration']} (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
+                )
+            self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
+            self.iteration = int(meta["iteration"])
+            self.counts = dict(meta["counts"])
         # Log chunks past the checkpoint belong to the lost work: they are rewritten.
         for chunk in (self.dir / LOG_DIR).glob("*.parquet"):
             if int(chunk.stem.split("-")[1]) >= self.iteration:
                 chunk.unlink()
+        self._extend_if_asked()
+
+    def _extend_if_asked(self) -> None:
+        config_path = self.dir / CONFIG_FILE
+        stored = storage.read_json(config_path)
+        asked, stored_total = self.settings.iterations, stored["trial"]["iterations"]
+        if asked == stored_total:
+            return
+        if asked < self.iteration:
+            raise TrialError(
+                f"{self.dir} holds {self.iteration} iterations already; --iterations {asked} "
+                "would shorten it"
+            )
+        stale = self.dir / f"{STALE_PREFIX}{self.iteration:08d}"
+        derived = [p for p in self.dir.iterdir() if p.name not in TRIAL_ENTRIES]
+        derived = [p for p in derived if not p.name.startswith(STALE_PREFIX)]
+        if derived:
+            stale.mkdir(exist_ok=True)
+            for path in derived:
+                shutil.move(path, stale / path.name)
+            self.notices.append(
+                f"extended from {stored_total} to {asked} iterations; the shorter run's "
+                f"{', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"
+            )
+        storage.write_json(config_path, self.config)
 
     # The loop -----------------------------------------------------------------------------
     def run(self, progress: bool = True) -> None:
@@ -274,10 +379,14 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     return agent, room
 
 
-def restore_checkpoint(trial_dir: str | os.PathLike, agent: Agent, room: Playroom) -> dict:
+def restore_checkpoint(
+    trial_dir: str | os.PathLike, agent: Agent, room: Playroom, name: str = CHECKPOINT_FILE
+) -> dict:
     """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
     with 'best_word_distance' added. CorruptFileError if it cannot be read or restored."""
-    path = Path(trial_dir) / CHECKPOINT_FILE
+    path = Path(trial_dir) / name
+    if not path.exists():
+        raise storage.CorruptFileError(f"{path} is missing")
     arrays, meta = storage.read_arrays(path)
     try:
         agent_state = {
@@ -296,11 +405,18 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
     trial_dir = Path(trial_dir)
     if not (trial_dir / CONFIG_FILE).exists():
         raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    if not (trial_dir / CHECKPOINT_FILE).exists():
+    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
         raise TrialError(f"{trial_dir} has no checkpoint yet")
     config = storage.read_json(trial_dir / CONFIG_FILE)
     agent, room = fresh_trial_parts(config)
-    meta = restore_checkpoint(trial_dir, agent, room)
+    try:
+        meta = restore_checkpoint(trial_dir, agent, room)
+    except storage.CorruptFileError as exc:
+        if (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
+            raise storage.CorruptFileError(
+                f"{exc}; `playroom run --resume` continues from the previous checkpoint"
+            ) from None
+        raise
     return config, agent, room, meta
 
 
@@ -313,14 +429,24 @@ def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataF
 
 
 def run_trial(
-    out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False, progress=True
+    out_dir: str | os.PathLike,
+    settings: TrialSettings,
+    resume: bool = False,
+    progress: bool = True,
+    notify: Callable[[str], None] | None = None,
 ) -> Trial:
-    """Create (or resume) a trial in out_dir and run it to the end."""
+    """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
+    the run, with each line a resume has to report (a fallback checkpoint, an extension)."""
     trial = Trial(out_dir, settings, resume=resume)
-    if trial.finished:
-        return trial
-    trial.start_iteration = trial.iteration
-    start = time.perf_counter()
-    trial.run(progress=progress)
-    trial.elapsed = time.perf_counter() - start
+    for notice in trial.notices if notify is not None else ():
+        notify(notice)
+    try:
+        if trial.finished:
+            return trial
+        trial.start_iteration = trial.iteration
+        start = time.perf_counter()
+        trial.run(progress=progress)
+        trial.elapsed = time.perf_counter() - start
+    finally:
+        trial.close()
     return trial

@@ -8,37 +8,35 @@ their time. `write` encodes the frames with mediapy, mixes the clips into one WA
 muxes both into the MP4 with the ffmpeg binary of imageio-ffmpeg, then moves the file into
 place atomically.
 
-Rendering is offscreen through EGL by default (Mesa's EGL works without a GPU);
-`MUJOCO_GL=osmesa` is the fallback, set before Python imports mujoco.
+Rendering is offscreen with the OpenGL backend MuJoCo loaded (`MUJOCO_GL`): the `playroom`
+command chooses EGL by default before importing mujoco (experiments/gl.py); a program of one's
+own sets `MUJOCO_GL` before its first import of mujoco.
 """
 
 from __future__ import annotations
 
+import contextlib
+import math
 import os
+import re
+import subprocess
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
 
-# Must precede the first import of mujoco, which picks the GL backend once.
-os.environ.setdefault("MUJOCO_GL", "egl")
+import imageio_ffmpeg
+import mediapy
+import mujoco
+import numpy as np
+from scipy.io import wavfile
+from scipy.signal import resample_poly
 
-import contextlib  # noqa: E402
-import math  # noqa: E402
-import re  # noqa: E402
-import subprocess  # noqa: E402
-import tempfile  # noqa: E402
-import time  # noqa: E402
-from collections.abc import Callable, Iterator, Sequence  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-import imageio_ffmpeg  # noqa: E402
-import mediapy  # noqa: E402
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-from scipy.io import wavfile  # noqa: E402
-from scipy.signal import resample_poly  # noqa: E402
-
-from experiments.overlay import CameraView, Caption, Overlay  # noqa: E402
-from sim import Feedback, Playroom  # noqa: E402
-from sim import events as ev  # noqa: E402
-from sim.config import ARM_DIM, VOICE_DIM  # noqa: E402
+from experiments import gl
+from experiments.overlay import CameraView, Caption, Overlay
+from sim import Feedback, Playroom
+from sim import events as ev
+from sim.config import ARM_DIM, VOICE_DIM
 
 DEFAULT_SIZE = (640, 480)  # width, height (px)
 # 50 frames per second shows one 50-step movement in 1 s, which is also its simulated time
@@ -113,20 +111,6 @@ def _check_fps(fps: float) -> float:
     return float(fps)
 
 
-def _gl_backend() -> str:
-    """The GL backend mujoco uses, and whether it differs from MUJOCO_GL (mujoco reads the
-    variable once, when first imported)."""
-    wanted = os.environ.get("MUJOCO_GL", "(unset)")
-    context = getattr(mujoco, "GLContext", None)
-    used = context.__module__.split(".")[-1] if context is not None else "none"
-    if used not in (wanted, "none"):
-        return (
-            f"MUJOCO_GL={wanted}, but mujoco was imported before it was set and uses {used} "
-            "(set MUJOCO_GL in the environment)"
-        )
-    return f"MUJOCO_GL={wanted}"
-
-
 def _check_camera(camera: str, model: mujoco.MjModel) -> None:
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
         raise ValueError(f"unknown camera {camera!r}: choose one of {list(CAMERAS)}")
@@ -168,8 +152,9 @@ class FrameRecorder:
             self._renderer = mujoco.Renderer(model, self.height, self.width)
         except Exception as exc:  # the GL backends raise many kinds; all mean the same here
             raise RenderError(
-                f"cannot create an offscreen renderer with {_gl_backend()} "
-                f"({type(exc).__name__}: {exc}); try MUJOCO_GL=osmesa (needs libOSMesa)"
+                f"cannot create an offscreen renderer with "
+                f"{gl.VARIABLE}={os.environ.get(gl.VARIABLE, '(unset)')} "
+                f"({type(exc).__name__}: {exc}); {gl.choices()}"
             ) from exc
         self.frames: list[np.ndarray] = []
         self.views: list[CameraView] = []

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 
+from models import playroom_xml
 from sim.config import DEFAULT_WORLD
-
-MODEL_PATH = Path(__file__).resolve().parent.parent / "models" / "playroom.xml"
 
 TOYS = ("toy1", "toy2", "toy3")
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
@@ -29,9 +27,9 @@ class PlayroomPhysics(dm_mujoco.Physics):
     """
 
     @classmethod
-    def load(cls, path: str | os.PathLike = MODEL_PATH) -> PlayroomPhysics:
-        """Compile the playroom MJCF file."""
-        return cls.from_xml_path(str(path))
+    def load(cls, path: str | os.PathLike | None = None) -> PlayroomPhysics:
+        """Compile the playroom MJCF file (the packaged models/playroom.xml by default)."""
+        return cls.from_xml_path(str(path or playroom_xml()))
 
     def _cache_indices(self) -> None:
         m = self.model.ptr

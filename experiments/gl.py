@@ -1,0 +1,67 @@
+"""Which OpenGL backend MuJoCo loads, chosen by the command being run, never at import.
+
+MuJoCo (and dm_control) read `MUJOCO_GL` once, when first imported, and load that GL library
+then: with it unset they load GLFW, with `egl` PyOpenGL's EGL, which fails on machines whose
+libEGL cannot be loaded (most cluster nodes). So the `playroom` command decides before anything
+imports mujoco: commands that render ask for a backend (EGL unless the user chose another),
+every other command asks for none, so `run`, `eval`, `batch`, `report` and `compare` work on a
+machine without any GL library. A user's own `MUJOCO_GL` is always respected.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+VARIABLE = "MUJOCO_GL"
+# Offscreen backends MuJoCo can render with; EGL works with an NVIDIA driver or Mesa.
+RENDER_BACKENDS = ("egl", "osmesa", "glfw")
+DEFAULT_RENDER_BACKEND = "egl"
+# The value under which MuJoCo and dm_control load no GL library at all.
+NO_BACKEND = "disable"
+
+
+class GLError(Exception):
+    """No usable OpenGL backend for rendering; the message names MUJOCO_GL and its choices."""
+
+
+def choices() -> str:
+    """What a user can set, for error messages."""
+    return f"set {VARIABLE} to one of {', '.join(RENDER_BACKENDS)}"
+
+
+def without_rendering() -> None:
+    """For commands that never render: load no GL library (unless the user chose one)."""
+    if "mujoco" not in sys.modules:
+        os.environ.setdefault(VARIABLE, NO_BACKEND)
+
+
+def for_rendering() -> str:
+    """For commands that render: choose the backend (EGL by default), load it, and return its
+    name; GLError in one line if it cannot be loaded."""
+    chosen = os.environ.setdefault(VARIABLE, DEFAULT_RENDER_BACKEND).strip().lower()
+    if chosen not in RENDER_BACKENDS:
+        raise GLError(f"{VARIABLE}={chosen!r} cannot render: {choices()}")
+    try:
+        import mujoco
+
+        context_class = getattr(mujoco, "GLContext", None)
+        if context_class is None:
+            raise ImportError("mujoco loaded no GL context")
+        loaded = context_class.__module__.split(".")[-1]
+        if loaded != chosen:
+            raise GLError(
+                f"mujoco was imported before rendering was set up and uses {loaded}, not "
+                f"{VARIABLE}={chosen}; set {VARIABLE} before starting Python ({choices()})"
+            )
+        # A context of one pixel: a driver that loads but cannot render fails here, in one line,
+        # rather than deep inside the first frame.
+        context_class(1, 1).free()
+    except GLError:
+        raise
+    except Exception as exc:  # PyOpenGL raises AttributeError, OSError, ImportError, ...
+        raise GLError(
+            f"the OpenGL backend {VARIABLE}={chosen} cannot be loaded "
+            f"({type(exc).__name__}: {exc}); {choices()}"
+        ) from None
+    return chosen
