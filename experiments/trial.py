@@ -113,18 +113,6 @@ def full_config(settings: TrialSettings, learner: LearnerConfig | None = None) -
 EXTENSIBLE = ("trial.iterations",)
 
 
-def _config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, object, object]]:
-    """(dotted key, value in a, value in b) of every setting where two configs differ."""
-    out = []
-    for k in sorted(set(a) | set(b)):
-        va, vb = a.get(k), b.get(k)
-        if isinstance(va, dict) and isinstance(vb, dict):
-            out += _config_differences(va, vb, f"{prefix}{k}.")
-        elif va != vb:
-            out.append((f"{prefix}{k}", va, vb))
-    return out
-
-
 class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
@@ -184,7 +172,9 @@ class Trial:
                 )
             diff = [
                 f"{key}: {a!r} != {b!r}"
-                for key, a, b in _config_differences(storage.read_json(config_path), self.config)
+                for key, a, b in storage.config_differences(
+                    storage.read_json(config_path), self.config
+                )
                 if key not in EXTENSIBLE
             ]
             if diff:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from experiments import batch as batch_module
 from experiments import storage
 from experiments.batch import (
     TIMING_FILE,
@@ -82,7 +83,7 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
     spec = BatchSpec(
         grasps=("kinematic",),
         seeds=(0, 1),
-        iterations=2500,
+        iterations=1500,
         checkpoint_every=250,
         eval_placements=2,
     )
@@ -96,24 +97,29 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
         while not (target / CHECKPOINT_FILE).exists() and time.monotonic() < deadline:
             time.sleep(0.05)
         pids = client.run(os.getpid)
-        victim = next(iter(pids.values()))
-        os.kill(victim, signal.SIGKILL)
+        running = [a for a, keys in client.processing().items() if target.name in keys]
+        assert len(running) == 1, client.processing()
+        os.kill(pids[running[0]], signal.SIGKILL)
         results = batch.result(timeout=300)
     assert len(results) == 2
     for name, settings in spec.trials():
         log = read_log(tmp_path / name)
         assert list(log["iteration"]) == list(range(settings.iterations)), name
         assert is_complete(tmp_path / name)
+    # The retry resumed the killed trial from its checkpoint.
+    timing = storage.read_json(target / TIMING_FILE)
+    assert 0 < timing["iterations"] < spec.iterations
 
 
-def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys):
+def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys, monkeypatch):
+    # Nothing listens on port 9: a short wait for the scheduler is enough to give up.
+    monkeypatch.setattr(batch_module, "CONNECT_TIMEOUT_S", 1)
     with pytest.raises(BatchError, match="unknown profile"):
         load_spec("huge")
     bad = tmp_path / "bad.json"
     bad.write_text('{"seeds": 2, "iterations": 0}')
     with pytest.raises(BatchError, match="iterations"):
         load_spec(config_file=bad)
-    start = time.monotonic()
     code = main(
         [
             "batch",
@@ -125,7 +131,7 @@ def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys):
             "tcp://127.0.0.1:9",
         ]
     )
-    assert code == 2 and time.monotonic() - start < 30
+    assert code == 2
     err = capsys.readouterr().err
     assert "no Dask scheduler answered" in err and len(err.strip().splitlines()) == 1
     assert not any(Path(tmp_path / "b").glob("*/config.json"))

@@ -143,7 +143,8 @@ def test_chi_square_ignores_empty_columns():
     # [[10, 5], [5, 10]]: expected 7.5 everywhere, Yates |O - E| - 0.5 = 2: chi2 = 4 * 4 / 7.5.
     chi2, p = chi_square(np.array([[10, 0, 5], [5, 0, 10]]))
     assert chi2 == pytest.approx(16 / 7.5)
-    assert 0 < p < 1
+    # One degree of freedom: P(chi2_1 > x) = erfc(sqrt(x / 2)).
+    assert p == pytest.approx(math.erfc(math.sqrt(16 / 7.5 / 2)))
     assert math.isnan(chi_square(np.array([[3, 0, 0], [4, 0, 0]]))[1])
 
 

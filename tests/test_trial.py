@@ -93,14 +93,10 @@ def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path, grasp, seed):
         assert read_log(whole, kind).equals(read_log(killed, kind))
 
 
-def test_a_3000_iteration_run_learns_to_reach_hand_goals(tmp_path):
+def test_a_3000_iteration_run_learns_to_reach_hand_goals(trained_trial):
     """After 3000 kinematic iterations the hand model reaches random reachable hand goals better
     than an agent that acts at random."""
-    trial = run_trial(
-        tmp_path / "t",
-        TrialSettings(iterations=3000, seed=0, checkpoint_every=3000),
-        progress=False,
-    )
+    trial = trained_trial
     agent = trial.agent
     rng = np.random.default_rng(123)
     room = Playroom("kinematic", seed=77)
