@@ -30,8 +30,8 @@ def _positive_int(text: str) -> int:
 
 def cmd_random(args: argparse.Namespace) -> None:
     """Random arm commands in one backend, with a summary of what happened."""
+    from models.layout import ARM_DIM
     from sim import Playroom
-    from sim.config import ARM_DIM
 
     room = Playroom(grasp=args.grasp, seed=args.seed)
     rng = np.random.default_rng(args.seed)

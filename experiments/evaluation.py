@@ -28,10 +28,8 @@ from experiments import storage
 from experiments.lock import DirectoryLock, DirectoryLocked
 from experiments.trial import TrialLocked, load_trial
 from learner.agent import Agent
+from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
-from sim.config import ARM_DIM, SENSORY_BLOCKS, VOICE_DIM
-from sim.playroom import MOVE_TOLERANCE as MOVED
-from sim.playroom import PLACEMENT_CLEARANCE
 from sim.vocal.config import DEFAULT_VOICE
 
 EVAL_FILE = "eval.json"
@@ -42,8 +40,6 @@ GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
 # Evaluation placements come from their own seed, the same for every trial and backend, so
 # that trials are compared on identical tests.
 EVAL_SEED = 20170000
-# Toys of one placement keep this far apart (m): two solid toys cannot overlap.
-MIN_TOY_GAP = 2 * 0.035 + PLACEMENT_CLEARANCE  # 0.035 m: the toys' radius in the MJCF
 
 
 @dataclass(frozen=True)
@@ -58,9 +54,12 @@ def goal_trajectory(toy: np.ndarray) -> np.ndarray:
     return np.concatenate([points[:, 0], points[:, 1]])
 
 
-def placements(ring: tuple[float, float], n: int, rng: np.random.Generator) -> np.ndarray:
+def placements(
+    ring: tuple[float, float], n: int, rng: np.random.Generator, min_gap: float
+) -> np.ndarray:
     """(n, 3, 2) toy positions, each toy uniform in the ring (area-uniform radius is not the
-    study's rule: like the world's placements, the radius is uniform), toys apart."""
+    study's rule: like the world's placements, the radius is uniform), toys at least
+    `min_gap` (m) apart: two solid toys cannot overlap."""
     out = np.empty((n, 3, 2))
     for p in range(n):
         for i in range(3):
@@ -68,7 +67,7 @@ def placements(ring: tuple[float, float], n: int, rng: np.random.Generator) -> n
                 radius = rng.uniform(*ring)
                 angle = rng.uniform(0.0, 2 * np.pi)
                 xy = radius * np.array([np.cos(angle), np.sin(angle)])
-                if all(np.linalg.norm(xy - out[p, j]) >= MIN_TOY_GAP for j in range(i)):
+                if all(np.linalg.norm(xy - out[p, j]) >= min_gap for j in range(i)):
                     break
             out[p, i] = xy
     return out
@@ -79,10 +78,6 @@ def strategy_of(motor_space: str, stick_moved: bool) -> str:
     if motor_space == "voice":
         return "vocal"
     return "tool" if stick_moved else "hand"
-
-
-def _act(room: Playroom, motor_space: str, m: np.ndarray):
-    return room.act_arm(m) if motor_space == "arm" else room.act_voice(m)
 
 
 def competence_table(
@@ -96,7 +91,7 @@ def competence_table(
     total = len(room.config.toy_rings) * settings.n_placements * 3
     bar = tqdm(total=total, disable=not progress, desc="evaluation", unit="test")
     for ring_index, ring in enumerate(room.config.toy_rings, start=1):
-        toys_of = placements(ring, settings.n_placements, rng)
+        toys_of = placements(ring, settings.n_placements, rng, room.min_toy_gap)
         caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
         for p in range(settings.n_placements):
             room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])
@@ -104,7 +99,7 @@ def competence_table(
             context = room.context()
             for toy in range(3):
                 goal = goal_trajectory(toys_of[p, toy])
-                block = SENSORY_BLOCKS[f"toy{toy + 1}"]
+                block = block_slice(f"toy{toy + 1}")
                 arm_model, voice_model = agent.toy_models(toy + 1)
                 d_arm = agent.nearest_distance(arm_model, context, goal)
                 d_voice = agent.nearest_distance(voice_model, context, goal)
@@ -112,14 +107,14 @@ def competence_table(
                 untrained = not np.isfinite(min(d_arm, d_voice))
                 # A toy never moved has no model to invert: the arm stays at rest.
                 command = np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
-                feedback = _act(room, space, command)
-                stick = feedback.s[SENSORY_BLOCKS["stick"]]  # 5 x then 5 y
-                stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED
+                feedback = room.act(space, command)
+                stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
+                stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
                 error = float(np.linalg.norm(feedback.s[block] - goal))
                 room.set_state(scene)
                 random_space = "arm" if rng.random() < 0.5 else "voice"
-                dim = ARM_DIM if random_space == "arm" else VOICE_DIM
-                random_fb = _act(room, random_space, rng.uniform(-1, 1, dim))
+                dim = MOTOR_DIMS[random_space]
+                random_fb = room.act(random_space, rng.uniform(-1, 1, dim))
                 random_error = float(np.linalg.norm(random_fb.s[block] - goal))
                 room.set_state(scene)
                 rows.append(

@@ -1,14 +1,16 @@
 """The figures of a batch report, one per result of the paper, drawn with matplotlib.
 
-Every function takes the tables of `experiments.report.BatchResults` and returns a
+Every function takes the tables of `experiments.results.BatchResults` and returns a
 `matplotlib.figure.Figure` holding one panel (or one line) per group of trials, so that the
 same figure serves a single batch and a comparison of two. Figures are built without pyplot:
-no global state, no display, the Agg canvas renders them to PNG.
+no global state, no display, the Agg canvas renders them to PNG. `report_figures` draws
+them all, with the titles and captions the report shows.
 """
 
 from __future__ import annotations
 
 import io
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -17,7 +19,9 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 from matplotlib.ticker import MaxNLocator
 
-STRATEGIES = ("hand", "tool", "vocal")
+from experiments.results import BatchResults, Geometry
+from experiments.statistics import STRATEGIES, competence_summary, curve_bands
+
 STRATEGY_COLOURS = {"hand": "tab:blue", "tool": "tab:orange", "vocal": "tab:green"}
 # Groups take colours in order, the same in every figure of a report.
 GROUP_COLOURS = ("tab:purple", "tab:red", "tab:cyan", "tab:olive", "tab:brown", "tab:pink")
@@ -182,7 +186,7 @@ def vocal_errors(vocal: pd.DataFrame, groups: list[str], threshold: float) -> Fi
 
 def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshold: float) -> Figure:
     """Developmental curves: tool use, recognised words and best word distance over time.
-    `bands`: group, metric, iteration, mean, low, high (`experiments.report.curve_bands`)."""
+    `bands`: group, metric, iteration, mean, low, high (`experiments.statistics.curve_bands`)."""
     fig, axes = _panels(3, width=5.0, height=4.2)
     # (axis, [(metric, line style)], y label, scale, largest possible value): intervals are
     # clipped to what a share or a distance can be, the t interval of few trials is not.
@@ -249,7 +253,7 @@ def competence_by_ring(
     trials: pd.DataFrame, summary: pd.DataFrame, groups: list[str], paper_mean: float
 ) -> Figure:
     """Per-trial normalised competence, overall and per ring (dots), with the means and 95%
-    intervals of `summary` (group, scope, mean, low, high: `experiments.report`)."""
+    intervals of `summary` (group, scope, mean, low, high: `statistics.competence_summary`)."""
     scopes = list(dict.fromkeys(summary["scope"]))
     fig = Figure(figsize=(9.0, 4.6), layout="constrained")
     ax = fig.subplots()
@@ -279,3 +283,62 @@ def competence_by_ring(
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(alpha=0.3, axis="y")
     return fig
+
+
+class FigureFile(NamedTuple):
+    """A figure of the report as a file: name (e.g. fig3-competence-map.png), title and
+    caption (plain text, shown beside it) and its PNG bytes."""
+
+    name: str
+    title: str
+    caption: str
+    png: bytes
+
+
+def report_figures(
+    results: BatchResults, geometry: Geometry, paper_mean: float
+) -> list[FigureFile]:
+    """Every figure of a report, one panel or line per group; `paper_mean`: the paper's mean
+    normalised competence (a fraction), drawn as a reference line."""
+    g = results.groups
+    drawn = [
+        (
+            "fig3-competence-map.png",
+            "Competence by toy position (paper Fig. 3)",
+            "Normalised competence 1 − Σerror / Σrandom error of the tests whose toy lies in "
+            "each cell, pooled over trials: 0% is the random agent on the same placements, 100% "
+            "a perfect retrieval. Dashed circles: hand and stick reach limits.",
+            competence_map(results.competence, g, geometry.hand_limit, geometry.stick_limit),
+        ),
+        (
+            "fig4-strategies.png",
+            "Strategy preference by toy distance (paper Fig. 4)",
+            "Share of tests in which the agent chose the hand (arm, stick still), the tool "
+            "(arm, stick moved) or its voice (caregiver's help), by the toy's distance to the "
+            "arm's base. Vertical bars: hand and stick reach limits.",
+            strategy_by_distance(results.competence, g, geometry.hand_limit, geometry.stick_limit),
+        ),
+        (
+            "fig5-vocal-errors.png",
+            "Vocal imitation errors, toy names vs distractors (paper Fig. 5)",
+            "Best (lowest) distance between each of the caregiver's words and any sound the "
+            f"agent produced; below {geometry.threshold:g} the caregiver recognises the word.",
+            vocal_errors(results.vocal, g, geometry.threshold),
+        ),
+        (
+            "development.png",
+            "Developmental curves",
+            "Per window of iterations, mean over trials with a 95% interval: share of arm "
+            "movements that moved a toy with the stick, share of vocal movements the caregiver "
+            "recognised as a word, and mean best distance so far to the trial's toy names "
+            "(solid) and distractors (dashed). Grey: the random bootstrap.",
+            development(curve_bands(results.curves), g, geometry.bootstrap, geometry.threshold),
+        ),
+        (
+            "competence-per-trial.png",
+            "Competence per trial and ring",
+            "Each dot is one trial's normalised competence; diamonds: mean with 95% t interval.",
+            competence_by_ring(results.trials, competence_summary(results.trials), g, paper_mean),
+        ),
+    ]
+    return [FigureFile(name, title, caption, png_bytes(fig)) for name, title, caption, fig in drawn]

@@ -15,8 +15,8 @@ import mujoco
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from models.layout import TRACKED_OBJECTS as TRACKED
 from sim import events as ev
-from sim.playroom import TRACKED
 
 # Blocks of the sensory space that are object positions (5 x then 5 y, metres); the sixth
 # block, "sound", is not drawn in the room.

@@ -19,9 +19,10 @@ from tqdm import tqdm
 from experiments import storage
 from experiments.trial import CONFIG_FILE, fresh_trial_parts, log_row, read_log
 from experiments.video import EpisodeRenderer, check_output_path, film_iteration, parse_size
-from learner.sensorimotor_model import MODELS
+from learner.agent import Proposal
+from models.layout import MODELS, TOYS
+from models.world import Feedback
 from sim.dmp import voice_trajectory
-from sim.physics import TOYS
 from sim.vocal.audio import synthesise, synthesise_word
 
 
@@ -110,29 +111,28 @@ def render_trial(
     bar = tqdm(total=wanted[-1] + 1, disable=not progress, desc="replay", unit="it")
     with EpisodeRenderer(size, fps, camera) as renderer:
         for it in range(wanted[-1] + 1):
-            context = room.context()
-            proposal = agent.propose(context)
             if it in wanted:
-                feedback = film_iteration(
-                    renderer,
-                    room,
-                    proposal.motor_space,
-                    proposal.m,
-                    voice_audio=lambda m: synthesise(voice_trajectory(m)),
-                    word_audio=synthesise_word,
-                    model=None if proposal.model is None else f"{proposal.model + 1}",
-                    goal=proposal.goal,
-                    goal_block=_goal_block(proposal.model),
-                    iteration=it,
-                )
+
+                def filmed(proposal: Proposal, it: int = it) -> Feedback:
+                    return film_iteration(
+                        renderer,
+                        room,
+                        proposal.motor_space,
+                        proposal.m,
+                        voice_audio=lambda m: synthesise(voice_trajectory(m)),
+                        word_audio=synthesise_word,
+                        model=None if proposal.model is None else f"{proposal.model + 1}",
+                        goal=proposal.goal,
+                        goal_block=_goal_block(proposal.model),
+                        iteration=it,
+                    )
+
+                proposal, _, feedback = agent.play(room, act=filmed)
                 logged = {"iteration": it, **logged_rows.loc[it].to_dict()}
                 replayed = log_row(it, proposal, feedback)
                 results.append(ReplayedIteration(it, logged, replayed))
-            elif proposal.motor_space == "arm":
-                feedback = room.act_arm(proposal.m)
             else:
-                feedback = room.act_voice(proposal.m)
-            agent.learn(proposal, context, feedback.s)
+                agent.play(room)
             bar.update(1)
         bar.close()
         path = renderer.write(out)

@@ -22,11 +22,15 @@ def write_bytes(path: Path, data: bytes) -> None:
     """Write `data` to `path` atomically: through a temporary file beside it, then a rename."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)  # a failed write (disk full, killed) leaves no litter
+        raise
 
 
 def write_json(path: Path, obj: Any) -> None:

@@ -40,11 +40,11 @@ from experiments import storage
 from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
 from learner.agent import Agent
 from learner.config import LearnerConfig
+from models.layout import TOYS, block_slice
 from sim import Playroom
 from sim import events as ev
-from sim.config import DEFAULT_WORLD
-from sim.physics import TOYS
-from sim.vocal.config import DEFAULT_VOICE
+from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict
+from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
 
 CONFIG_FILE = "config.json"
@@ -95,13 +95,19 @@ class TrialSettings:
             raise TrialError(f"seed must be a non-negative integer, got {self.seed!r}")
 
 
-def full_config(settings: TrialSettings, learner: LearnerConfig | None = None) -> dict:
-    """Every setting of a trial, as written to config.json."""
+def full_config(
+    settings: TrialSettings,
+    world: WorldConfig = DEFAULT_WORLD,
+    voice: VoiceConfig = DEFAULT_VOICE,
+    learner: LearnerConfig | None = None,
+) -> dict:
+    """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
+    the trial's room and agent from."""
     learner = learner or LearnerConfig(babbling=settings.babbling)
     config = {
         "trial": dataclasses.asdict(settings),
-        "world": dataclasses.asdict(DEFAULT_WORLD),
-        "voice": dataclasses.asdict(DEFAULT_VOICE),
+        "world": dataclasses.asdict(world),
+        "voice": dataclasses.asdict(voice),
         "learner": learner.to_dict(),
         "package_version": version("playroom"),
     }
@@ -299,15 +305,10 @@ class Trial:
         bar.close()
 
     def _iterate(self) -> dict:
-        context = self.room.context()
-        proposal = self.agent.propose(context)
-        if proposal.motor_space == "arm":
-            feedback = self.room.act_arm(proposal.m)
-        else:
-            feedback = self.room.act_voice(proposal.m)
-        self.agent.learn(proposal, context, feedback.s)
+        proposal, _, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
-            distances = word_distances(feedback.s[50:60], self.room.vocal_tract.config)
+            sound = feedback.s[block_slice("sound")]
+            distances = word_distances(sound, self.room.vocal_tract.config)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
         row = log_row(self.iteration, proposal, feedback)
         self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)
@@ -361,7 +362,12 @@ def log_row(iteration: int, proposal, feedback) -> dict:
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     """The agent and room of a trial's iteration 0, as its config makes them."""
     settings = config["trial"]
-    room = Playroom(grasp=settings["grasp"], seed=settings["seed"])
+    room = Playroom(
+        grasp=settings["grasp"],
+        seed=settings["seed"],
+        config=config_from_dict(WorldConfig, config["world"]),
+        voice=config_from_dict(VoiceConfig, config["voice"]),
+    )
     agent = Agent(
         LearnerConfig.from_dict(config["learner"]),
         np.random.default_rng([settings["seed"], AGENT_STREAM]),

@@ -1,7 +1,8 @@
 """The Model Babbling agent (protocol.md, "Learning"): bootstrap, goals, imitation, learning.
 
-One iteration is `proposal = agent.propose(context)`, the world executes `proposal.m` with the
-arm or the voice, then `agent.learn(proposal, context, s)` with the feedback s (60,).
+One iteration is `agent.play(world)`: `proposal = agent.propose(context)`, the world executes
+`proposal.m` with the arm or the voice, then `agent.learn(proposal, context, s)` with the
+feedback s (60,).
 
 - Bootstrap: the first `bootstrap_arm + bootstrap_voice` proposals are uniformly random
   commands, their motor spaces in a shuffled order drawn at construction.
@@ -21,6 +22,7 @@ agent restored from a checkpoint continues bit-identically.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,7 +31,17 @@ from numpy.typing import ArrayLike
 
 from learner.config import LearnerConfig
 from learner.interest import InterestModel
-from learner.sensorimotor_model import MODELS, ModelSpec, SensorimotorModel, block_slice
+from learner.sensorimotor_model import SensorimotorModel
+from models.layout import (
+    BLOCK_DIM,
+    CONTEXT_DIM,
+    MODELS,
+    MOTOR_DIMS,
+    SENSORY_DIM,
+    ModelSpec,
+    block_slice,
+)
+from models.world import Feedback, World
 
 _SPACE_CODE = {"arm": 0, "voice": 1}  # bootstrap order is stored as these codes
 
@@ -69,9 +81,9 @@ class Agent:
         self._bootstrap_order = self.rng.permutation(order)
         self.t = 0  # iterations learnt
         # Ring buffer of the sounds heard after the last `imitation_memory` arm movements.
-        self._heard = np.zeros((cfg.imitation_memory, cfg.block_dim))
+        self._heard = np.zeros((cfg.imitation_memory, BLOCK_DIM))
         self._n_heard = 0
-        self._sound_slice = block_slice("sound", cfg.block_dim)
+        self._sound_slice = block_slice("sound")
         self._pending: Proposal | None = None
 
     # ------------------------------------------------------------------ the learning loop
@@ -82,7 +94,7 @@ class Agent:
         cfg = self.config
         if self.t < cfg.n_bootstrap:
             space = "arm" if self._bootstrap_order[self.t] == 0 else "voice"
-            m = self.rng.uniform(cfg.motor_low, cfg.motor_high, cfg.motor_dim(space))
+            m = self.rng.uniform(cfg.motor_low, cfg.motor_high, MOTOR_DIMS[space])
             proposal = Proposal(space, m, None, None, "bootstrap", False)
         else:
             k = self.interest.choose(self.rng)
@@ -108,12 +120,29 @@ class Agent:
         self._pending = proposal
         return proposal
 
+    def play(
+        self, world: World, act: Callable[[Proposal], Feedback] | None = None
+    ) -> tuple[Proposal, np.ndarray, Feedback]:
+        """One iteration in `world`: observe the context, propose, act, learn.
+
+        act: how the proposal is executed, by default `world.act(motor_space, m)`; a caller
+        that films the movement passes its own. Returns (proposal, context, feedback).
+        """
+        context = np.asarray(world.context(), dtype=float)
+        proposal = self.propose(context)
+        if act is None:
+            feedback = world.act(proposal.motor_space, proposal.m)
+        else:
+            feedback = act(proposal)
+        self.learn(proposal, context, feedback.s)
+        return proposal, context, feedback
+
     def learn(self, proposal: Proposal, context: ArrayLike, s: ArrayLike) -> None:
         """Learn from the feedback s (60,) of `proposal`, executed in `context` (10,)."""
         if proposal is not self._pending:
             raise ValueError("learn() takes the proposal returned by the last propose()")
         context = self._check_context(context)
-        s = _checked_vector(s, self.config.sensory_dim, "feedback s")
+        s = _checked_vector(s, SENSORY_DIM, "feedback s")
         m = proposal.m
         for k in self._by_space[proposal.motor_space]:
             self.models[k].update(m, context, s)
@@ -224,7 +253,7 @@ class Agent:
         return sounds[self.rng.integers(len(sounds))].copy()
 
     def _check_context(self, context: ArrayLike) -> np.ndarray:
-        return _checked_vector(context, self.config.context_dim, "context")
+        return _checked_vector(context, CONTEXT_DIM, "context")
 
 
 def _checked_vector(value: ArrayLike, dim: int, what: str) -> np.ndarray:

@@ -21,7 +21,7 @@ from learner.agent import Agent
 from learner.config import LearnerConfig
 from learner.memory import NearestNeighbourMemory, brute_force_nearest
 from learner.sensorimotor_model import MODELS
-from learner.synthetic import SyntheticWorld
+from models.world import World
 
 INVERSE_KEY_DIMS = tuple(sorted({len(spec.context_dims) + 10 for spec in MODELS}))
 
@@ -67,23 +67,22 @@ def query_ratio(
 
 
 def learner_overhead(
+    world: World,
     n_rows: int = 80000,
     n_iterations: int = 1000,
     babbling: str = "random",
     seed: int = 0,
 ) -> dict[str, Any]:
-    """Seconds per iteration of the learner alone, every model holding `n_rows` experiences.
+    """Seconds per iteration of the learner alone, every model holding `n_rows` experiences,
+    playing in `world` (whose own time is not counted).
 
     Returns {'mean_s', 'median_s', 'p99_s', 'model_bytes', 'n_rows', 'babbling'}; model_bytes
     is what the 10 models' arrays hold after the run.
     """
     config = LearnerConfig(babbling=babbling)
     agent = Agent(config, rng=seed)
-    world = SyntheticWorld(seed + 1)
     for _ in range(config.n_bootstrap):  # the bootstrap, untimed
-        context = world.context()
-        proposal = agent.propose(context)
-        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m))
+        agent.play(world)
     rng = np.random.default_rng(seed + 2)
     for model in agent.models:
         missing = n_rows - len(model)
@@ -99,7 +98,7 @@ def learner_overhead(
         start = time.perf_counter()
         proposal = agent.propose(context)
         elapsed = time.perf_counter() - start
-        s = world.act(proposal.motor_space, proposal.m)
+        s = world.act(proposal.motor_space, proposal.m).s
         start = time.perf_counter()
         agent.learn(proposal, context, s)
         times[i] = elapsed + time.perf_counter() - start
@@ -110,15 +109,4 @@ def learner_overhead(
         "median_s": float(np.median(times)),
         "p99_s": float(np.quantile(times, 0.99)),
         "model_bytes": int(sum(model.nbytes() for model in agent.models)),
-    }
-
-
-def run(n_rows: int = 80000, seed: int = 0) -> dict[str, Any]:
-    """Both measurements: {'query': query_ratio(...), 'overhead': {mode: learner_overhead}}."""
-    return {
-        "query": query_ratio(n_rows=n_rows, seed=seed),
-        "overhead": {
-            mode: learner_overhead(n_rows=n_rows, babbling=mode, seed=seed)
-            for mode in ("random", "active")
-        },
     }

@@ -4,7 +4,7 @@ The learner sees vectors only, so its units are those of the vectors: motor comm
 sensory goals live in [-1, 1]; positions in the sensory feedback are in the paper's length
 units (metres in the MJCF model); sounds are in normalised log2-Hz (protocol.md, "Sensory
 feedback"). The 10 sensorimotor models (which motor space, context and sensory dimensions each
-uses) are the table `learner.sensorimotor_model.MODELS`.
+uses) are the table `models.layout.MODELS`, with every size of the vectors.
 """
 
 from __future__ import annotations
@@ -14,21 +14,17 @@ import json
 from dataclasses import dataclass
 from typing import Any
 
+from models import layout
+
 BABBLING_MODES = ("random", "active")
 IMITATION_DRAWS = ("distinct", "heard")
 
 
 @dataclass(frozen=True)
 class LearnerConfig:
-    # Motor spaces (protocol.md, "One iteration"): parameters in [motor_low, motor_high].
-    arm_dim: int = 21  # 3 joints x (6 DMP weights + 1 end position)
-    voice_dim: int = 28  # 7 articulators x (start, end, 2 DMP weights)
+    # Motor commands live in [motor_low, motor_high] (their sizes: models/layout.py).
     motor_low: float = -1.0
     motor_high: float = 1.0
-    # What the world shows the learner (protocol.md, "One iteration" and "Sensory feedback").
-    context_dim: int = 10  # stick handle, toy1, toy2, toy3, caregiver: x, y each
-    sensory_dim: int = 60  # hand, stick, toy1, toy2, toy3, sound: 10 values each
-    samples_per_block: int = 5  # a 10D block is 5 x samples then 5 y samples (or F1, F2)
     # Bootstrap (protocol.md): random commands before any goal babbling, in shuffled order.
     bootstrap_arm: int = 500  # commands
     bootstrap_voice: int = 500  # commands
@@ -54,19 +50,10 @@ class LearnerConfig:
     # Storing rule: a sensory block "changed" when a value differs from its reference by more
     # than this (metres for positions, normalised log2-Hz for sounds). It absorbs the jitter of
     # resting objects in the physical backend; real movements are centimetres.
-    change_tolerance: float = 1e-3
+    change_tolerance: float = layout.MOVED_DISTANCE
 
     def __post_init__(self) -> None:
-        positive_ints = (
-            "arm_dim",
-            "voice_dim",
-            "context_dim",
-            "sensory_dim",
-            "samples_per_block",
-            "progress_window",
-            "imitation_memory",
-        )
-        for name in positive_ints:
+        for name in ("progress_window", "imitation_memory"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value <= 0:
                 raise ValueError(f"LearnerConfig.{name} must be a positive integer, got {value!r}")
@@ -100,27 +87,10 @@ class LearnerConfig:
                 f"LearnerConfig.imitation_draw must be one of {IMITATION_DRAWS}, "
                 f"got {self.imitation_draw!r}"
             )
-        if self.sensory_dim % (2 * self.samples_per_block) != 0:
-            raise ValueError(
-                f"LearnerConfig.sensory_dim ({self.sensory_dim}) must be a whole number of "
-                f"blocks of 2 * samples_per_block ({2 * self.samples_per_block})"
-            )
-
-    @property
-    def block_dim(self) -> int:
-        """Values in one sensory block (10): x then y samples, or F1 then F2."""
-        return 2 * self.samples_per_block
 
     @property
     def n_bootstrap(self) -> int:
         return self.bootstrap_arm + self.bootstrap_voice
-
-    def motor_dim(self, motor_space: str) -> int:
-        if motor_space == "arm":
-            return self.arm_dim
-        if motor_space == "voice":
-            return self.voice_dim
-        raise ValueError(f"unknown motor space {motor_space!r}: expected 'arm' or 'voice'")
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)

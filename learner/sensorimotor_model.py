@@ -19,93 +19,39 @@ Storing rule (protocol.md: "only when its sensory part changed during the moveme
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import ArrayLike
 
 from learner.config import LearnerConfig
 from learner.memory import NearestNeighbourMemory
-
-# Layout of the world's vectors (protocol.md, "One iteration" and "Sensory feedback").
-CONTEXT_SLOTS: dict[str, tuple[int, int]] = {
-    "stick": (0, 1),  # handle x, y
-    "toy1": (2, 3),
-    "toy2": (4, 5),
-    "toy3": (6, 7),
-    "caregiver": (8, 9),
-}
-SENSORY_BLOCKS: tuple[str, ...] = ("hand", "stick", "toy1", "toy2", "toy3", "sound")
-MOTOR_SPACES: tuple[str, ...] = ("arm", "voice")
-_INITIAL_CAPACITY = 1024  # rows preallocated per model, doubled when full
-
-
-@dataclass(frozen=True)
-class ModelSpec:
-    """One sensorimotor model: motor space -> sensory block | context slots."""
-
-    number: int  # 1..10, as in protocol.md
-    motor_space: str  # "arm" or "voice"
-    sensory_block: str  # one of SENSORY_BLOCKS
-    context_slots: tuple[str, ...]  # keys of CONTEXT_SLOTS, in this order in c_i
-    imitates_caregiver: bool = False  # draws some goals from heard caregiver sounds
-
-    @property
-    def name(self) -> str:
-        context = ", ".join(self.context_slots) or "none"
-        return f"{self.motor_space} -> {self.sensory_block} | {context}"
-
-    @property
-    def context_dims(self) -> tuple[int, ...]:
-        """Indices into the context c (10,) of this model's context c_i."""
-        return tuple(i for slot in self.context_slots for i in CONTEXT_SLOTS[slot])
-
-    def sensory_slice(self, block_dim: int) -> slice:
-        """Slice of the feedback s (60,) holding this model's sensory block s_i."""
-        return block_slice(self.sensory_block, block_dim)
-
-
-def block_slice(block: str, block_dim: int) -> slice:
-    """Slice of the feedback s (60,) holding the named block of SENSORY_BLOCKS."""
-    k = SENSORY_BLOCKS.index(block)
-    return slice(k * block_dim, (k + 1) * block_dim)
-
-
-# The 10 models of protocol.md, "The 10 sensorimotor models".
-MODELS: tuple[ModelSpec, ...] = (
-    ModelSpec(1, "arm", "hand", ()),
-    ModelSpec(2, "arm", "stick", ("stick",)),
-    ModelSpec(3, "arm", "toy1", ("stick", "toy1")),
-    ModelSpec(4, "arm", "toy2", ("stick", "toy2")),
-    ModelSpec(5, "arm", "toy3", ("stick", "toy3")),
-    ModelSpec(6, "arm", "sound", ("stick", "toy1", "toy2", "toy3")),
-    ModelSpec(7, "voice", "toy1", ("toy1", "caregiver")),
-    ModelSpec(8, "voice", "toy2", ("toy2", "caregiver")),
-    ModelSpec(9, "voice", "toy3", ("toy3", "caregiver")),
-    ModelSpec(10, "voice", "sound", (), imitates_caregiver=True),
+from models.layout import (
+    BLOCK_DIM,
+    CONTEXT_SLOTS,
+    MODELS,
+    MOTOR_DIMS,
+    N_SAMPLES,
+    ModelSpec,
+    context_indices,
 )
+
+__all__ = ["MODELS", "ModelSpec", "SensorimotorModel"]
+
+_INITIAL_CAPACITY = 1024  # rows preallocated per model, doubled when full
 
 
 class SensorimotorModel:
     """The experiences of one ModelSpec, with nearest-neighbour inverse and forward models."""
 
     def __init__(self, spec: ModelSpec, config: LearnerConfig) -> None:
-        if spec.motor_space not in MOTOR_SPACES:
-            raise ValueError(f"model {spec.number}: unknown motor space {spec.motor_space!r}")
-        if spec.sensory_block not in SENSORY_BLOCKS:
-            raise ValueError(f"model {spec.number}: unknown sensory block {spec.sensory_block!r}")
-        unknown = [slot for slot in spec.context_slots if slot not in CONTEXT_SLOTS]
-        if unknown:
-            raise ValueError(f"model {spec.number}: unknown context slots {unknown}")
-        self.spec = spec
-        self.motor_dim = config.motor_dim(spec.motor_space)
+        self.spec = spec  # a ModelSpec checks its own spaces, block and slots
+        self.motor_dim = MOTOR_DIMS[spec.motor_space]
         self.context_dims = np.array(spec.context_dims, dtype=np.intp)
-        self.sensory_slice = spec.sensory_slice(config.block_dim)
-        self.sensory_dim = config.block_dim
-        self._samples = config.samples_per_block
+        self.sensory_slice = spec.sensory_slice
+        self.sensory_dim = BLOCK_DIM
         self._tolerance = config.change_tolerance
         # Where the block's object was before the movement, if the context says it.
-        start = CONTEXT_SLOTS.get(spec.sensory_block)
+        has_start = spec.sensory_block in CONTEXT_SLOTS
+        start = context_indices(spec.sensory_block) if has_start else None
         self._start_dims = None if start is None else np.array(start, dtype=np.intp)
         c_dim = len(self.context_dims)
         self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
@@ -138,7 +84,7 @@ class SensorimotorModel:
         block = s[self.sensory_slice]
         if self.spec.sensory_block == "sound":
             return bool(np.any(np.abs(block) > self._tolerance))
-        xy = block.reshape(2, self._samples)  # row 0: x samples, row 1: y samples
+        xy = block.reshape(2, N_SAMPLES)  # row 0: x samples, row 1: y samples
         if self._start_dims is not None:
             start = context[self._start_dims][:, None]
         else:

@@ -31,6 +31,11 @@ TRACKED_OBJECTS: tuple[str, ...] = ("hand", "stick", *TOYS)  # the blocks that a
 SENSORY_BLOCKS: tuple[str, ...] = (*TRACKED_OBJECTS, "sound")
 SENSORY_DIM = BLOCK_DIM * len(SENSORY_BLOCKS)  # 60
 
+# An object's block "changed" once a sample lies farther than this from where the object
+# started (m; for the sound, normalised log2 Hz): the learner's storing rule and the world's
+# "moved" events share it. Resting objects in contact jitter by far less; movements are cm.
+MOVED_DISTANCE = 1e-3
+
 # Context (docs/protocol.md §4): positions before the movement, x then y of each slot.
 CONTEXT_SLOTS: tuple[str, ...] = ("stick", *TOYS, "caregiver")
 CONTEXT_DIM = 2 * len(CONTEXT_SLOTS)  # 10

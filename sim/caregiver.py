@@ -1,8 +1,10 @@
-"""The caregiver's body: where she stands, and how she brings a toy toward the agent.
+"""The caregiver (docs/protocol.md §6): where she stands, the words she uses, what she says
+after an arm movement, what she hears of the agent's voice, and how she brings a toy.
 
-What she hears and says (words) is the voice's part (sim/vocal/words.py); this module moves
-things. In the physical backend she carries the toy with her hand, a mocap body welded to the
-toy; in the kinematic backend the toy is placed directly, as in the study.
+The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
+which word names which toy is hers, drawn once per room. In the physical backend she carries a
+toy with her hand, a mocap body welded to the toy, lifted above the table; in the kinematic
+backend the toy is placed directly, as in the study.
 """
 
 from __future__ import annotations
@@ -10,24 +12,38 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.physics import TOYS, PlayroomPhysics
+from models.layout import N_STEPS, TOYS
+from sim import events as ev
+from sim.config import WorldConfig
+from sim.model_edits import ModelEdits
+from sim.physics import OBJECTS, PlayroomPhysics
+from sim.vocal.tract import VocalTract
+from sim.vocal.words import WordAssignment, assign_words, word_features
+
+# The name under which she edits the model (sim/model_edits.py).
+OWNER = "caregiver"
 
 
 class Caregiver:
-    """Places the caregiver and moves a toy toward the midpoint between her and the arm's base.
+    """The caregiver of one room. `rng` is the room's generator: she draws her words from it
+    now, and her place and distractors from it later, in the room's order of draws."""
 
-    The study moves the toy `bring_rate` (1%) of the remaining way at each control step, about
-    40% of the way over one 50-step movement (protocol.md).
-    """
-
-    def __init__(self, physical: bool, config: WorldConfig = DEFAULT_WORLD) -> None:
+    def __init__(
+        self,
+        physical: bool,
+        config: WorldConfig,
+        vocal_tract: VocalTract,
+        edits: ModelEdits,
+        rng: np.random.Generator,
+    ) -> None:
         self.physical = physical
         self.config = config
+        self.vocal_tract = vocal_tract
+        self.edits = edits
+        self.words: WordAssignment = assign_words(rng, vocal_tract.config)
         self.bringing: int | None = None  # index of the toy she is bringing
-        self._collision_bits = (0, 0)  # contype, conaffinity of the toy she carries
-        self._damping = np.zeros(3)  # its joints' damping on the table
 
+    # Where she stands ----------------------------------------------------------------------
     def place(self, physics: PlayroomPhysics, rng: np.random.Generator) -> None:
         """A new position, uniform in the square [-box, box]^2."""
         box = self.config.caregiver_box
@@ -40,6 +56,30 @@ class Caregiver:
         """(2,) midpoint between the caregiver and the arm's base at (0, 0)."""
         return physics.caregiver_position() / 2.0
 
+    # What she says and hears ---------------------------------------------------------------
+    def speak(self, held: str | None, rng: np.random.Generator) -> tuple[np.ndarray, ev.Event]:
+        """After an arm movement: the name of the toy in the hand, else a random distractor.
+        Returns the word's sound features (10,) and the event."""
+        if held in TOYS:
+            word, obj = self.words.names[TOYS.index(held)], held
+        else:
+            word, obj = self.words.distractors[rng.integers(len(self.words.distractors))], None
+        features = word_features(word, config=self.vocal_tract.config)
+        return features, ev.Event(ev.CAREGIVER_SAID, N_STEPS, obj=obj, word=word)
+
+    def hear(self, physics: PlayroomPhysics, voice_formants: np.ndarray) -> list[ev.Event]:
+        """She listens to the agent's coming sound, (N_STEPS, 2) log2 Hz; if it is a toy's
+        name she starts bringing that toy."""
+        tract = self.vocal_tract
+        word = tract.recognise(tract.features_from_formants(voice_formants))
+        if word is None:
+            return []
+        toy = self.words.toy_of(word)
+        if toy is not None:
+            self.start_bringing(physics, toy)
+        return [ev.Event(ev.WORD_RECOGNISED, 1, obj=None if toy is None else TOYS[toy], word=word)]
+
+    # How she brings a toy ------------------------------------------------------------------
     def start_bringing(self, physics: PlayroomPhysics, toy: int) -> None:
         """Take toy `toy` (0-based) and bring it over the coming control steps."""
         self.bringing = toy
@@ -48,26 +88,16 @@ class Caregiver:
         m, d = physics.model.ptr, physics.data.ptr
         hand = physics.caregiver_hand_mocap
         d.mocap_pos[hand, :2] = physics.toy_positions()[toy]
-        eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"caregiver_{TOYS[toy]}")
-        # Her hand sits exactly on the toy, so the weld's relative pose is the identity apart
-        # from the height difference between her hand and the toy.
         mujoco.mj_kinematics(m, d)
-        body = physics.toy_bodies[toy]
-        m.eq_data[eq, 0:3] = 0.0
-        m.eq_data[eq, 3:6] = d.xpos[body] - d.mocap_pos[hand]
-        m.eq_data[eq, 6:10] = (1.0, 0.0, 0.0, 0.0)
-        d.eq_active[eq] = 1
+        # Her hand sits on the toy: the weld holds it there, upright.
+        self.edits.weld_here(OWNER, f"caregiver_{TOYS[toy]}", keep_orientation=False)
         # She lifts the toy: while carried it touches nothing, as a toy carried above the
         # table would not (dragged along the table it would sweep the stick out of reach).
-        geom = physics.toy_geoms[toy]
-        self._collision_bits = (int(m.geom_contype[geom]), int(m.geom_conaffinity[geom]))
-        m.geom_contype[geom] = m.geom_conaffinity[geom] = 0
-        dofs = physics.object_dof[1 + toy]
-        self._damping = m.dof_damping[dofs].copy()
-        m.dof_damping[dofs] = 0.0  # no table friction above the table
+        self.edits.make_intangible(OWNER, physics.toy_geoms[toy])
+        self.edits.lift(OWNER, OBJECTS.index(TOYS[toy]))
 
     def before_step(self, physics: PlayroomPhysics) -> None:
-        """Move the toy she is bringing `bring_rate` of the remaining way."""
+        """Move the toy she is bringing `caregiver_bring_rate` of the remaining way."""
         if self.bringing is None:
             return
         rate = self.config.caregiver_bring_rate
@@ -86,14 +116,8 @@ class Caregiver:
         if self.bringing is None:
             return
         if self.physical:
-            m, d = physics.model.ptr, physics.data.ptr
-            eq = mujoco.mj_name2id(
-                m, mujoco.mjtObj.mjOBJ_EQUALITY, f"caregiver_{TOYS[self.bringing]}"
-            )
-            d.eq_active[eq] = 0
-            geom = physics.toy_geoms[self.bringing]
-            m.geom_contype[geom], m.geom_conaffinity[geom] = self._collision_bits
-            m.dof_damping[physics.object_dof[1 + self.bringing]] = self._damping
+            self.edits.clear(OWNER)
+            d = physics.data.ptr
             d.qvel[physics.object_dof] = 0.0
             d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
         self.bringing = None

@@ -11,6 +11,13 @@ import functools
 
 import numpy as np
 
+from models.layout import (
+    ARM_BASIS_FUNCTIONS,
+    N_ARTICULATORS,
+    N_JOINTS,
+    N_STEPS,
+    VOICE_BASIS_FUNCTIONS,
+)
 from sim.config import DEFAULT_WORLD, WorldConfig
 
 # Spring-damper gains of the transformation system, critically damped (beta = alpha / 4).
@@ -60,7 +67,7 @@ def _response_matrix(n_bfs: int, n_steps: int) -> np.ndarray:
 
 
 def rollout(
-    start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int = DEFAULT_WORLD.n_steps
+    start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int = N_STEPS
 ) -> np.ndarray:
     """Trajectories of `d` DMPs.
 
@@ -75,21 +82,21 @@ def rollout(
 def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
     """21 arm parameters in [-1, 1] -> (3, n_steps) joint angles in rad, relative to rest.
 
-    Per joint: `arm_bfs` weights then 1 end position. The DMP starts at rest (0); the
+    Per joint: `ARM_BASIS_FUNCTIONS` weights then 1 end position. The DMP starts at rest (0); the
     trajectory is bounded to [-1, 1] and scaled by pi (protocol.md).
     """
-    per_joint = np.asarray(m, dtype=float).reshape(3, config.arm_bfs + 1)
+    per_joint = np.asarray(m, dtype=float).reshape(N_JOINTS, ARM_BASIS_FUNCTIONS + 1)
     weights = per_joint[:, :-1] * config.dmp_weight_scale
-    traj = rollout(np.zeros(3), per_joint[:, -1], weights, config.n_steps)
+    traj = rollout(np.zeros(N_JOINTS), per_joint[:, -1], weights, N_STEPS)
     return np.pi * np.clip(traj, -1.0, 1.0)
 
 
 def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
     """28 voice parameters in [-1, 1] -> (7, n_steps) articulator values in [-1, 1].
 
-    Per articulator: start, end, then `voice_bfs` weights (protocol.md).
+    Per articulator: start, end, then `VOICE_BASIS_FUNCTIONS` weights (protocol.md).
     """
-    per_art = np.asarray(m, dtype=float).reshape(7, config.voice_bfs + 2)
+    per_art = np.asarray(m, dtype=float).reshape(N_ARTICULATORS, VOICE_BASIS_FUNCTIONS + 2)
     weights = per_art[:, 2:] * config.dmp_weight_scale
-    traj = rollout(per_art[:, 0], per_art[:, 1], weights, config.n_steps)
+    traj = rollout(per_art[:, 0], per_art[:, 1], weights, N_STEPS)
     return np.clip(traj, -1.0, 1.0)

@@ -14,11 +14,9 @@ import mujoco
 import numpy as np
 
 from sim import events as ev
-from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.physics import TOYS, PlayroomPhysics
-
-# Collision bits of the MJCF model (models/playroom.xml).
-HAND_BIT, STICK_BIT, TOY_BIT = 1, 2, 4
+from sim.config import WorldConfig
+from sim.model_edits import ModelEdits
+from sim.physics import OBJECTS, TOYS, PlayroomPhysics
 
 
 class GraspBackend(abc.ABC):
@@ -26,7 +24,7 @@ class GraspBackend(abc.ABC):
 
     name: str
 
-    def __init__(self, config: WorldConfig = DEFAULT_WORLD) -> None:
+    def __init__(self, config: WorldConfig) -> None:
         self.config = config
         self.hand_holds: str | None = None  # "stick", "toy1", ... or None
         self.stick_holds: int | None = None  # index of the toy on the stick's tip
@@ -150,21 +148,9 @@ class PhysicalGrasp(GraspBackend):
 
     name = "physical"
 
-    def __init__(self, config: WorldConfig = DEFAULT_WORLD) -> None:
+    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
         super().__init__(config)
-        self._base_conaffinity: np.ndarray | None = None
-
-    def _welds(self, physics: PlayroomPhysics) -> dict[str, int]:
-        m = physics.model.ptr
-        names = ["hand_stick"] + [f"hand_{t}" for t in TOYS] + [f"stick_{t}" for t in TOYS]
-        return {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n) for n in names}
-
-    def begin(self, physics: PlayroomPhysics) -> None:
-        super().begin(physics)
-        if self._base_conaffinity is None:
-            self._base_conaffinity = physics.model.ptr.geom_conaffinity.copy()
-            self._base_damping = physics.model.ptr.dof_damping.copy()
-            self._weld_ids = self._welds(physics)
+        self.edits = edits
 
     def before_step(
         self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
@@ -183,13 +169,13 @@ class PhysicalGrasp(GraspBackend):
             toys = np.isin(physics.toy_geoms, touched) & free
             if physics.handle_geom in touched:
                 self.hand_holds = "stick"
-                self._weld(physics, "hand_stick")
+                self._hold(physics, "hand_stick", "stick")
                 events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
             elif toys.any():
                 toy = TOYS[int(np.argmax(toys))]
                 self.hand_holds = toy
                 free[TOYS.index(toy)] = False
-                self._weld(physics, f"hand_{toy}")
+                self._hold(physics, f"hand_{toy}", toy)
                 events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
         # A stick lying on the table catches nothing: only a stick in the hand is a tool.
         if self.hand_holds == "stick" and self.stick_holds is None:
@@ -197,66 +183,37 @@ class PhysicalGrasp(GraspBackend):
             if toys.any():
                 self.stick_holds = int(np.argmax(toys))
                 toy = TOYS[self.stick_holds]
-                self._weld(physics, f"stick_{toy}")
+                self._hold(physics, f"stick_{toy}", toy)
                 events.append(ev.Event(ev.TOY_CAUGHT, step, obj=toy, by="stick"))
-        if events:
-            self._filter_collisions(physics)
         return events
 
-    def _weld(self, physics: PlayroomPhysics, name: str) -> None:
-        """Activate a weld at the bodies' current relative pose.
-
-        The weld's reference pose is fixed at compile time; activating it unchanged would snap
-        the object to that pose (shared/notes.md), so the current pose of body2 in body1's
-        frame is written first.
-        """
-        m, d = physics.model.ptr, physics.data.ptr
-        eq = self._weld_ids[name]
-        b1, b2 = m.eq_obj1id[eq], m.eq_obj2id[eq]
-        rel_pos, rel_quat = np.zeros(3), np.zeros(4)
-        inv_q1 = np.zeros(4)
-        mujoco.mju_negQuat(inv_q1, d.xquat[b1])
-        mujoco.mju_rotVecQuat(rel_pos, d.xpos[b2] - d.xpos[b1], inv_q1)
-        mujoco.mju_mulQuat(rel_quat, inv_q1, d.xquat[b2])
-        m.eq_data[eq, 0:3] = 0.0
-        m.eq_data[eq, 3:6] = rel_pos
-        m.eq_data[eq, 6:10] = rel_quat
-        d.eq_active[eq] = 1
-        # The held object is lifted off the table: no table friction while it is carried.
-        row = physics.object_bodies.tolist().index(b2)
-        m.dof_damping[physics.object_dof[row]] = 0.0
-
-    def _filter_collisions(self, physics: PlayroomPhysics) -> None:
-        """Stop each held object from colliding with what holds it, and only with that.
+    def _hold(self, physics: PlayroomPhysics, weld: str, obj: str) -> None:
+        """Weld `obj` where it is to its holder, lift it off the table (no table friction while
+        carried), and stop it colliding with its holder (and only with it).
 
         MuJoCo makes a contact when one geom's contype meets the other's conaffinity, so a
         holder and its object each lose the other's bit from their conaffinity.
         """
-        m = physics.model.ptr
-        conaff = self._base_conaffinity.copy()
-        hand, stick = physics.hand_geom, physics.stick_geoms
-        if self.hand_holds == "stick":
-            conaff[hand] &= ~STICK_BIT
-            conaff[stick] &= ~HAND_BIT
-        elif self.hand_holds in TOYS:
-            toy = physics.toy_geoms[TOYS.index(self.hand_holds)]
-            conaff[hand] &= ~TOY_BIT
-            conaff[toy] &= ~HAND_BIT
-        if self.stick_holds is not None:
-            toy = physics.toy_geoms[self.stick_holds]
-            conaff[stick] &= ~TOY_BIT
-            conaff[toy] &= ~STICK_BIT
-        m.geom_conaffinity[:] = conaff
+        self.edits.weld_here(self.name, weld)
+        self.edits.lift(self.name, OBJECTS.index(obj))
+        holder = weld.split("_")[0]
+        holder_geoms = [physics.hand_geom] if holder == "hand" else list(physics.stick_geoms)
+        object_geoms = (
+            list(physics.stick_geoms) if obj == "stick" else [physics.toy_geoms[TOYS.index(obj)]]
+        )
+        # The collision bit of a kind of geom is its contype in the MJCF model.
+        holder_bit = self.edits.compiled_contype(holder_geoms[0])
+        object_bit = self.edits.compiled_contype(object_geoms[0])
+        for geom in holder_geoms:
+            self.edits.ignore(self.name, geom, object_bit)
+        for geom in object_geoms:
+            self.edits.ignore(self.name, geom, holder_bit)
 
     def release(self, physics: PlayroomPhysics) -> None:
-        d = physics.data.ptr
-        for eq in self._weld_ids.values():
-            d.eq_active[eq] = 0
         self.hand_holds = None
         self.stick_holds = None
-        physics.model.ptr.geom_conaffinity[:] = self._base_conaffinity
-        physics.model.ptr.dof_damping[:] = self._base_damping
-        d.qvel[physics.object_dof] = 0.0
+        self.edits.clear(self.name)
+        physics.data.ptr.qvel[physics.object_dof] = 0.0
         _arm_to_rest(physics)
 
 
@@ -265,11 +222,14 @@ def _partners(pairs: np.ndarray, geom: int) -> np.ndarray:
     return np.concatenate([pairs[pairs[:, 0] == geom, 1], pairs[pairs[:, 1] == geom, 0]])
 
 
-BACKENDS: dict[str, type[GraspBackend]] = {"kinematic": KinematicGrasp, "physical": PhysicalGrasp}
+BACKENDS = ("kinematic", "physical")
 
 
-def make_backend(name: str, config: WorldConfig = DEFAULT_WORLD) -> GraspBackend:
-    """The grasp backend called `name` ('kinematic' or 'physical')."""
-    if name not in BACKENDS:
-        raise ValueError(f"unknown grasp backend {name!r}: choose one of {sorted(BACKENDS)}")
-    return BACKENDS[name](config)
+def make_backend(name: str, config: WorldConfig, edits: ModelEdits) -> GraspBackend:
+    """The grasp backend called `name` ('kinematic' or 'physical'); the physical one edits the
+    model through `edits`."""
+    if name == "kinematic":
+        return KinematicGrasp(config)
+    if name == "physical":
+        return PhysicalGrasp(config, edits)
+    raise ValueError(f"unknown grasp backend {name!r}: choose one of {list(BACKENDS)}")

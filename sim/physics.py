@@ -9,9 +9,9 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 
 from models import playroom_xml
-from sim.config import DEFAULT_WORLD
+from models.layout import TOYS
+from sim.config import DEFAULT_WORLD, WorldConfig
 
-TOYS = ("toy1", "toy2", "toy3")
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
 OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw
 # Physics steps per control step: the model's 2 ms timestep makes a 20 ms control step, so a
@@ -26,10 +26,58 @@ class PlayroomPhysics(dm_mujoco.Physics):
     call, and these measurements run every control step.
     """
 
+    config: WorldConfig = DEFAULT_WORLD
+
     @classmethod
-    def load(cls, path: str | os.PathLike | None = None) -> PlayroomPhysics:
-        """Compile the playroom MJCF file (the packaged models/playroom.xml by default)."""
-        return cls.from_xml_path(str(path or playroom_xml()))
+    def load(
+        cls, config: WorldConfig = DEFAULT_WORLD, path: str | os.PathLike | None = None
+    ) -> PlayroomPhysics:
+        """Compile the playroom MJCF file (the packaged models/playroom.xml by default) for the
+        world `config`; ValueError naming every length on which the two disagree."""
+        physics = cls.from_xml_path(str(path or playroom_xml()))
+        physics.config = config
+        mismatches = physics.disagreements_with(config)
+        if mismatches:
+            raise ValueError(
+                f"the MJCF model {path or 'models/playroom.xml'} and the WorldConfig disagree: "
+                + "; ".join(mismatches)
+            )
+        return physics
+
+    def disagreements_with(self, config: WorldConfig) -> list[str]:
+        """Where the model's geometry differs from the config's numbers (1e-9 m or rad)."""
+        m = self.model.ptr
+        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
+        site = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, n)  # noqa: E731
+        key = m.key_qpos[self.home_key]
+        upper_arm_yaw = 2.0 * np.arctan2(
+            m.body_quat[body("upper_arm"), 3], m.body_quat[body("upper_arm"), 0]
+        )
+        model_numbers = {
+            "segment_lengths[0]": m.body_pos[body("forearm"), 0],
+            "segment_lengths[1]": m.body_pos[body("hand_link"), 0],
+            "segment_lengths[2]": m.site_pos[site("hand"), 0],
+            "arm_rest_offset": upper_arm_yaw,
+            "stick_length": m.site_pos[site("stick_tip"), 0],
+            "stick_start_handle[0]": key[self.object_qpos[0, 0]],
+            "stick_start_handle[1]": key[self.object_qpos[0, 1]],
+            "stick_start_angle": key[self.object_qpos[0, 2]],
+        }
+        config_numbers = {
+            "segment_lengths[0]": config.segment_lengths[0],
+            "segment_lengths[1]": config.segment_lengths[1],
+            "segment_lengths[2]": config.segment_lengths[2],
+            "arm_rest_offset": config.arm_rest_offset,
+            "stick_length": config.stick_length,
+            "stick_start_handle[0]": config.stick_start_handle[0],
+            "stick_start_handle[1]": config.stick_start_handle[1],
+            "stick_start_angle": config.stick_start_angle,
+        }
+        return [
+            f"{name}: model {model_numbers[name]:.6g}, config {value:.6g}"
+            for name, value in config_numbers.items()
+            if abs(model_numbers[name] - value) > 1e-9
+        ]
 
     def _cache_indices(self) -> None:
         m = self.model.ptr
@@ -84,7 +132,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
 
     def hand_angle(self) -> float:
         """Orientation of the last segment in the plane (rad), as the protocol defines it."""
-        return float(self.arm_angles().sum() + DEFAULT_WORLD.arm_rest_offset)
+        return float(self.arm_angles().sum() + self.config.arm_rest_offset)
 
     def arm_angles(self) -> np.ndarray:
         """(3,) joint angles relative to rest (rad)."""

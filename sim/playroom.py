@@ -3,53 +3,42 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 from dm_control.rl import control
 
+from models.layout import (
+    ARM_DIM,
+    MOVED_DISTANCE,
+    N_ARTICULATORS,
+    N_JOINTS,
+    N_STEPS,
+    SAMPLE_INDICES,
+    SENSORY_DIM,
+    TOYS,
+    TRACKED_OBJECTS,
+    VOICE_DIM,
+    block_slice,
+)
+from models.world import Feedback
 from sim import events as ev
 from sim.caregiver import Caregiver
-from sim.config import ARM_DIM, CONTEXT_DIM, DEFAULT_WORLD, SENSORY_DIM, VOICE_DIM, WorldConfig
+from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.grasp import BACKENDS, make_backend
-from sim.physics import CONTROL_SUBSTEPS, TOYS, KinematicPhysics, PlayroomPhysics
-from sim.task import ARM, N_ARTICULATORS, N_JOINTS, VOICE, PlayroomTask
+from sim.model_edits import ModelEdits
+from sim.physics import CONTROL_SUBSTEPS, KinematicPhysics, PlayroomPhysics
+from sim.task import ARM, VOICE, PlayroomTask
+from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.tract import VocalTract
-from sim.vocal.words import WordAssignment, assign_words, word_features
+from sim.vocal.words import WordAssignment
 
-# An object counts as moved once it is this far from where it started (m). Contacts of
-# resting objects jitter by far less.
-MOVE_TOLERANCE = 1e-3
 # Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
 RANGE_TOLERANCE = 1e-9
-# Rows of the recorded trajectory: the 5 tracked objects of the sensory space.
-TRACKED = ("hand", "stick", *TOYS)
 # Toys placed in the physical backend keep this clearance from each other and the stick (m):
 # two solid toys cannot share a place, and overlapping geoms would be pushed apart violently.
 PLACEMENT_CLEARANCE = 0.01
-
-
-@dataclass
-class Feedback:
-    """What the agent perceives of one movement.
-
-    s: (60,) hand, stick handle, toy1, toy2, toy3 (each 5 x then 5 y at the sample steps) and
-    sound (5 normalised log2 F1 then 5 log2 F2).
-    events: what happened, in step order.
-    positions: (50, 5, 2) the tracked objects after every control step.
-    sound: (50, 2) the sound sensor after every control step.
-    """
-
-    motor_space: str
-    s: np.ndarray
-    events: list[ev.Event] = field(default_factory=list)
-    positions: np.ndarray | None = None
-    sound: np.ndarray | None = None
-
-    def kinds(self) -> list[str]:
-        return [e.kind for e in self.events]
 
 
 class Playroom:
@@ -57,6 +46,8 @@ class Playroom:
 
     grasp: 'kinematic' (the study's distance rules) or 'physical' (MuJoCo contacts).
     seed: seeds every random choice of the world (placements, the caregiver's words).
+    config, voice: the world's and the voice's numbers; the MJCF model is checked against
+    `config` when it loads.
     exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
     a frame) instead of the fitted formant map (microseconds); for audio checks.
     """
@@ -66,6 +57,7 @@ class Playroom:
         grasp: str = "physical",
         seed: int = 0,
         config: WorldConfig = DEFAULT_WORLD,
+        voice: VoiceConfig = DEFAULT_VOICE,
         exact_voice: bool = False,
     ) -> None:
         if grasp not in BACKENDS:
@@ -76,12 +68,14 @@ class Playroom:
         self.seed = int(seed)
         self.config = config
         self.rng = np.random.default_rng(self.seed)
-        self.vocal_tract = VocalTract(exact=exact_voice)
-        self.words = assign_words(self.rng, self.vocal_tract.config)
+        self.vocal_tract = VocalTract(exact=exact_voice, config=voice, world=config)
         physics_class = KinematicPhysics if grasp == "kinematic" else PlayroomPhysics
-        self.physics: PlayroomPhysics = physics_class.load()
-        self.caregiver = Caregiver(physical=grasp == "physical", config=config)
-        self.task = PlayroomTask(make_backend(grasp, config), self.caregiver, self.vocal_tract)
+        self.physics: PlayroomPhysics = physics_class.load(config)
+        edits = ModelEdits(self.physics)
+        self.caregiver = Caregiver(grasp == "physical", config, self.vocal_tract, edits, self.rng)
+        self.task = PlayroomTask(
+            make_backend(grasp, config, edits), self.caregiver, self.vocal_tract
+        )
         self.env = control.Environment(
             self.physics, self.task, n_sub_steps=CONTROL_SUBSTEPS, time_limit=float("inf")
         )
@@ -99,6 +93,15 @@ class Playroom:
         return np.concatenate([p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()])
 
     # What the agent does ------------------------------------------------------------------
+    def act(self, motor_space: str, m: np.ndarray) -> Feedback:
+        """Execute command m in `motor_space` ('arm' or 'voice'): the `World` interface
+        (models/world.py) through which every caller acts."""
+        if motor_space == ARM:
+            return self.act_arm(m)
+        if motor_space == VOICE:
+            return self.act_voice(m)
+        raise ValueError(f"unknown motor space {motor_space!r}: 'arm' or 'voice'")
+
     def act_arm(self, m: np.ndarray) -> Feedback:
         """Execute 21 arm parameters in [-1, 1] (protocol.md) and return the feedback.
 
@@ -106,7 +109,7 @@ class Playroom:
         distractor: her word is the sound block s[50:60].
         """
         m = _checked_command(m, ARM_DIM, "arm command")
-        actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
+        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
         actions[:, :N_JOINTS] = arm_trajectory(m, self.config).T
         return self._run(ARM, actions)
 
@@ -119,7 +122,7 @@ class Playroom:
         """
         m = _checked_command(m, VOICE_DIM, "voice command")
         articulators = voice_trajectory(m, self.config)  # (7, n_steps)
-        actions = np.zeros((self.config.n_steps, N_JOINTS + N_ARTICULATORS))
+        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
         formants = self.vocal_tract.trajectory_formants(articulators)
@@ -128,26 +131,10 @@ class Playroom:
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
 
-    def _hear(self, voice_formants: np.ndarray) -> list[ev.Event]:
-        """The caregiver listens to the coming sound, (n_steps, 2) log2 Hz; she fetches the toy
-        it names."""
-        word = self.vocal_tract.recognise(self.vocal_tract.features_from_formants(voice_formants))
-        if word is None:
-            return []
-        toy = self.words.toy_of(word)
-        if toy is not None:
-            self.caregiver.start_bringing(self.physics, toy)
-        return [ev.Event(ev.WORD_RECOGNISED, 1, obj=None if toy is None else TOYS[toy], word=word)]
-
-    def _speak(self) -> tuple[np.ndarray, ev.Event]:
-        """After an arm movement: the name of the toy in the hand, else a random distractor."""
-        held = self.task.grasp.hand_holds
-        if held in TOYS:
-            word, obj = self.words.names[TOYS.index(held)], held
-        else:
-            word, obj = self.words.distractors[self.rng.integers(len(self.words.distractors))], None
-        features = word_features(word, config=self.vocal_tract.config)
-        return features, ev.Event(ev.CAREGIVER_SAID, self.config.n_steps, obj=obj, word=word)
+    @property
+    def words(self) -> WordAssignment:
+        """The caregiver's words of this room: which names which toy."""
+        return self.caregiver.words
 
     def arrange(
         self,
@@ -207,7 +194,7 @@ class Playroom:
         self.iteration = int(state["iteration"])
         self.rng.bit_generator.state = state["rng"]
         names, distractors = state["words"]
-        self.words = WordAssignment(tuple(names), tuple(distractors))
+        self.caregiver.words = WordAssignment(tuple(names), tuple(distractors))
 
     # The movement -------------------------------------------------------------------------
     def _run(
@@ -215,12 +202,12 @@ class Playroom:
     ) -> Feedback:
         p = self.physics
         saved = self.get_state()
-        n = self.config.n_steps
-        positions = np.empty((n + 1, len(TRACKED), 2))
+        n = N_STEPS
+        positions = np.empty((n + 1, len(TRACKED_OBJECTS), 2))
         sound = np.zeros((n, 2))
         positions[0] = p.tracked_positions()
         self.task.begin_movement(p, movement, voice_formants)
-        events = self._hear(voice_formants) if movement == VOICE else []
+        events = self.caregiver.hear(p, voice_formants) if movement == VOICE else []
         try:
             for k in range(n):
                 obs = self.env.step(actions[k]).observation
@@ -245,11 +232,15 @@ class Playroom:
             events += _movement_events(
                 positions, events, None if brought is None else TOYS[brought]
             )
-            said = self._speak() if movement == ARM else None
+            said = (
+                self.caregiver.speak(self.task.grasp.hand_holds, self.rng)
+                if movement == ARM
+                else None
+            )
             self.task.end_movement(p)
         s = self._sensory(positions[1:], sound)
         if said is not None:
-            s[50:], event = said
+            s[block_slice("sound")], event = said
             events.append(event)
         self.iteration += 1
         self._place_for_iteration()
@@ -257,11 +248,11 @@ class Playroom:
 
     def _sensory(self, positions: np.ndarray, sound: np.ndarray) -> np.ndarray:
         """(60,) from (50, 5, 2) positions and (50, 2) sound, sampled at the 5 steps."""
-        idx = list(self.config.sample_indices)
-        objects = positions[idx].transpose(1, 2, 0).reshape(len(TRACKED), 10)  # 5 x then 5 y
+        idx = list(SAMPLE_INDICES)
+        objects = positions[idx].transpose(1, 2, 0).reshape(len(TRACKED_OBJECTS), -1)  # x then y
         s = np.empty(SENSORY_DIM)
-        s[:50] = objects.ravel()
-        s[50:] = sound[idx].T.ravel()
+        s[: objects.size] = objects.ravel()
+        s[block_slice("sound")] = sound[idx].T.ravel()
         return s
 
     # Placements ---------------------------------------------------------------------------
@@ -290,6 +281,13 @@ class Playroom:
         radius = self.rng.uniform(low, high)
         angle = self.rng.uniform(0.0, 2.0 * np.pi)
         return radius * np.array([np.cos(angle), np.sin(angle)])
+
+    @property
+    def min_toy_gap(self) -> float:
+        """Distance (m) between the centres of two toys placed side by side: two toy radii
+        (from the MJCF) and the placement clearance."""
+        p = self.physics
+        return 2 * float(p.model.ptr.geom_size[p.toy_geoms[0], 0]) + PLACEMENT_CLEARANCE
 
     def _clear_of_others(self, position: np.ndarray, poses: np.ndarray, toy: int) -> bool:
         """Whether a toy at `position` would keep clear of the toys placed before it and the
@@ -322,8 +320,8 @@ def _movement_events(
     caught = {e.obj for e in step_events if e.kind == ev.TOY_CAUGHT}
     moved: list[ev.Event] = []
     displacement = np.linalg.norm(positions - positions[0], axis=2)  # (51, 5)
-    for row, name in enumerate(TRACKED[1:], start=1):
-        steps = np.flatnonzero(displacement[:, row] > MOVE_TOLERANCE)
+    for row, name in enumerate(TRACKED_OBJECTS[1:], start=1):
+        steps = np.flatnonzero(displacement[:, row] > MOVED_DISTANCE)
         if steps.size == 0:
             continue
         if name == "stick":
@@ -361,4 +359,4 @@ def _checked_command(m, dim: int, what: str) -> np.ndarray:
     return np.clip(arr, -1.0, 1.0)
 
 
-__all__ = ["CONTEXT_DIM", "Feedback", "Playroom"]
+__all__ = ["Feedback", "Playroom"]

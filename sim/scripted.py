@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from models.layout import ARM_BASIS_FUNCTIONS, N_JOINTS, N_STEPS
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import _response_matrix, arm_trajectory
 from sim.kinematics import hand_positions
@@ -56,7 +57,7 @@ def _hand_path(waypoints: list[Waypoint], config: WorldConfig) -> tuple[np.ndarr
         for w in waypoints
     ]
     angles = np.unwrap(angles)
-    t = np.arange(1, config.n_steps + 1)
+    t = np.arange(1, N_STEPS + 1)
     path = np.column_stack([np.interp(t, steps, points[:, i]) for i in range(2)])
     return path, np.interp(t, steps, angles)
 
@@ -67,11 +68,11 @@ def arm_command_through(
     """The (21,) command in [-1, 1] whose hand follows the waypoints, and its error: the largest
     distance (m) between the hand and a waypoint, on the analytic kinematics."""
     path, angles = _hand_path(waypoints, config)
-    response = _response_matrix(config.arm_bfs, config.n_steps)  # rows: start, end, weights
+    response = _response_matrix(ARM_BASIS_FUNCTIONS, N_STEPS)  # rows: start, end, weights
     # Per joint, the trajectory (before clipping, in units of pi) is end * R[1] + w @ R[2:].
     design = np.vstack([response[1], config.dmp_weight_scale * response[2:]]).T
     # The waypoints matter more than the straight lines drawn between them.
-    weight = np.ones(config.n_steps)
+    weight = np.ones(N_STEPS)
     weight[[w.step - 1 for w in waypoints]] = WAYPOINT_WEIGHT
     best: tuple[np.ndarray, float] | None = None
     for elbow in (1.0, -1.0):
@@ -79,7 +80,7 @@ def arm_command_through(
             [_inverse_kinematics(p, a, elbow, config) for p, a in zip(path, angles, strict=True)]
         )
         q = np.unwrap(q, axis=0) / np.pi
-        m = np.empty((3, config.arm_bfs + 1))
+        m = np.empty((N_JOINTS, ARM_BASIS_FUNCTIONS + 1))
         for j in range(3):
             fit = lsq_linear(design * weight[:, None], q[:, j] * weight, bounds=(-1.0, 1.0))
             m[j, -1], m[j, :-1] = fit.x[0], fit.x[1:]

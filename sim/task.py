@@ -14,6 +14,7 @@ import numpy as np
 from dm_control.rl import control
 from dm_env import specs
 
+from models.layout import N_ARTICULATORS, N_JOINTS
 from sim import events as ev
 from sim.caregiver import Caregiver
 from sim.grasp import GraspBackend
@@ -21,8 +22,6 @@ from sim.physics import PlayroomPhysics
 
 ARM = "arm"
 VOICE = "voice"
-N_JOINTS = 3
-N_ARTICULATORS = 7
 
 
 class PlayroomTask(control.Task):

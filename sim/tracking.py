@@ -6,7 +6,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from sim.config import ARM_DIM, DEFAULT_WORLD, WorldConfig
+from models.layout import ARM_DIM, N_STEPS
+from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory
 from sim.kinematics import hand_positions
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
@@ -24,13 +25,13 @@ def hand_tracking_errors(
     m, d = physics.model.ptr, physics.data.ptr
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     rng = np.random.default_rng(seed)
-    errors = np.empty((n_commands, config.n_steps))
-    hand = np.empty((config.n_steps, 2))
+    errors = np.empty((n_commands, N_STEPS))
+    hand = np.empty((N_STEPS, 2))
     for i in range(n_commands):
         targets = arm_trajectory(rng.uniform(-1.0, 1.0, ARM_DIM), config)
         mujoco.mj_resetDataKeyframe(m, d, physics.home_key)
         mujoco.mj_forward(m, d)
-        for k in range(config.n_steps):
+        for k in range(N_STEPS):
             d.ctrl[:] = targets[:, k]
             mujoco.mj_step(m, d, CONTROL_SUBSTEPS)
             mujoco.mj_kinematics(m, d)

@@ -18,8 +18,8 @@ from experiments.evaluation import (
     normalised_competence,
     strategy_of,
 )
+from models.layout import ARM_DIM
 from sim import Playroom
-from sim.config import ARM_DIM
 
 
 class RestingAgent:

@@ -1,4 +1,5 @@
-"""Unit tests of the learner package, with a synthetic world (no MuJoCo, no sim)."""
+"""Unit tests of the learner package, with a synthetic world (no MuJoCo: only the world's plain
+config modules are read, for the study's numbers)."""
 
 from __future__ import annotations
 
@@ -15,8 +16,21 @@ from learner.interest import InterestModel
 from learner.memory import NearestNeighbourMemory, brute_force_nearest
 from learner.sensorimotor_model import MODELS, SensorimotorModel
 from learner.synthetic import SyntheticWorld
+from sim.config import DEFAULT_WORLD
+from sim.vocal.config import DEFAULT_VOICE
 
 SMALL = LearnerConfig(bootstrap_arm=50, bootstrap_voice=50)
+
+
+def _world(seed: int) -> SyntheticWorld:
+    """A synthetic world with the study's numbers."""
+    return SyntheticWorld(
+        seed,
+        segment_lengths=DEFAULT_WORLD.segment_lengths,
+        grasp_distance=DEFAULT_WORLD.grasp_distance,
+        recognition_distance=DEFAULT_VOICE.recognition_distance,
+        replace_period=DEFAULT_WORLD.toy_replace_period,
+    )
 
 
 def _savez_round_trip(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -28,13 +42,7 @@ def _savez_round_trip(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 
 
 def _run(agent: Agent, world: SyntheticWorld, n: int) -> list[Proposal]:
-    proposals = []
-    for _ in range(n):
-        context = world.context()
-        proposal = agent.propose(context)
-        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m))
-        proposals.append(proposal)
-    return proposals
+    return [agent.play(world)[0] for _ in range(n)]
 
 
 # ---------------------------------------------------------------- memory
@@ -230,7 +238,7 @@ def test_learn_checks_its_input() -> None:
 
 def test_bootstrap_is_500_arm_and_500_voice_shuffled() -> None:
     agent = Agent(LearnerConfig(), rng=3)
-    world = SyntheticWorld(3)
+    world = _world(3)
     proposals = _run(agent, world, 1001)
     boot = proposals[:1000]
     spaces = [p.motor_space for p in boot]
@@ -246,7 +254,7 @@ def test_bootstrap_is_500_arm_and_500_voice_shuffled() -> None:
 def test_goal_babbling_uses_the_inverse_model_with_noise() -> None:
     config = LearnerConfig(bootstrap_arm=50, bootstrap_voice=50, exploration_sigma=0.0)
     agent = Agent(config, rng=5)
-    world = SyntheticWorld(5)
+    world = _world(5)
     _run(agent, world, 100)
     for _ in range(200):
         context = world.context()
@@ -256,10 +264,10 @@ def test_goal_babbling_uses_the_inverse_model_with_noise() -> None:
         if proposal.inferred:
             expected, _ = model.inverse(context, proposal.goal)
             np.testing.assert_array_equal(proposal.m, expected)
-        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m))
+        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m).s)
     # With noise, commands differ from the nearest experience but stay in bounds.
     noisy = Agent(SMALL, rng=5)
-    _run(noisy, SyntheticWorld(5), 100)
+    _run(noisy, _world(5), 100)
     context = world.context()
     for _ in range(20):
         proposal = noisy.propose(context)
@@ -270,7 +278,7 @@ def test_goal_babbling_uses_the_inverse_model_with_noise() -> None:
 
 def test_imitation_draws_goals_from_heard_caregiver_sounds() -> None:
     agent = Agent(SMALL, rng=7)
-    world = SyntheticWorld(7)
+    world = _world(7)
     _run(agent, world, 100)
     n_imitation = n_model10 = 0
     for _ in range(3000):
@@ -285,7 +293,7 @@ def test_imitation_draws_goals_from_heard_caregiver_sounds() -> None:
                 assert any(np.array_equal(proposal.goal, w) for w in world.words)
         else:
             assert proposal.kind == "goal"
-        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m))
+        agent.learn(proposal, context, world.act(proposal.motor_space, proposal.m).s)
     assert n_model10 > 200
     assert abs(n_imitation / n_model10 - 0.5) < 0.1
     heard = agent.heard_sounds
@@ -310,7 +318,7 @@ def test_same_seed_same_run_and_restored_agent_continues_identically() -> None:
 
     config = LearnerConfig(bootstrap_arm=50, bootstrap_voice=50, babbling="active")
     a, b = Agent(config, rng=11), Agent(config, rng=11)
-    world_a, world_b = SyntheticWorld(4), SyntheticWorld(4)
+    world_a, world_b = _world(4), _world(4)
     for x, y in zip(proposals_of(a, world_a, 400), proposals_of(b, world_b, 400), strict=True):
         np.testing.assert_array_equal(x, y)
 
@@ -337,7 +345,7 @@ def test_restore_refuses_another_config() -> None:
 
 def test_learning_beats_random_commands_on_hand_goals() -> None:
     agent = Agent(LearnerConfig(), rng=2)
-    world = SyntheticWorld(2)
+    world = _world(2)
     _run(agent, world, 2000)
     rng = np.random.default_rng(0)
     targets = [world.hand(m).T.ravel() for m in rng.uniform(-1, 1, (50, 21))]
@@ -437,7 +445,7 @@ def test_bench_checks_the_memory_against_brute_force_and_fills_the_models(monkey
     with pytest.raises(AssertionError, match="brute force"):
         bench.query_ratio(n_rows=100, dims=(10,), n_queries=2, repeats=1)
 
-    overhead = bench.learner_overhead(n_rows=2000, n_iterations=20, babbling="active")
+    overhead = bench.learner_overhead(_world(1), n_rows=2000, n_iterations=20, babbling="active")
     assert overhead["n_rows"] == 2000 and overhead["babbling"] == "active"
     # Every model was filled to n_rows float64 rows of (m, c_i, s_i) before the timed part.
     motor_dim = {"arm": 21, "voice": 28}

@@ -1,35 +1,41 @@
-"""Reports of a batch (`experiments.report`): files, embedded figures, statistics checked by
-hand, and bad input refused with one line and nothing written."""
+"""Reports of a batch (`experiments.report`, `.comparison`, `.results`, `.statistics`,
+`.paper`): files, embedded figures, statistics checked by hand, the paper's numbers beside
+ours, escaped HTML, and bad input refused with one line and nothing written."""
 
 from __future__ import annotations
 
 import base64
+import dataclasses
+import html
 import json
 import math
 import re
 import shutil
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from experiments import figures
+from experiments import figures, paper
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
 from experiments.report import (
     COMPARISON_FILE,
     REPORT_FILE,
     ReportError,
+    write_comparison,
+    write_report,
+)
+from experiments.results import collect
+from experiments.statistics import (
     chi_square,
-    collect,
     cost_per_iteration,
     mann_whitney,
     mean_ci,
     strategy_table,
     vocal_summary,
     welch,
-    write_comparison,
-    write_report,
 )
 from experiments.trial import TrialSettings, run_trial
 
@@ -247,3 +253,82 @@ def test_a_batch_of_both_backends_holds_two_groups(batches, tmp_path):
     physical = results.select("physical")
     assert physical.groups == ["physical"] and set(physical.competence["group"]) == {"physical"}
     assert len(physical.trials) == 1
+
+
+# The paper's numbers and the page's HTML --------------------------------------------------------
+
+
+def _spellings(value: float) -> set[str]:
+    """How the paper may write a number: 46%, 0.30, 500, 10^{-72}."""
+    if value >= 1:
+        return {f"{value:g}"}
+    if value >= 0.01:
+        return {f"{value:g}", f"{value:.2f}", f"{round(100 * value)}%"}
+    return {f"10^{{{round(math.log10(value))}}}"}
+
+
+def _leaves(value) -> list[float]:
+    if isinstance(value, dict):
+        return [x for v in value.values() for x in _leaves(v)]
+    if isinstance(value, list):
+        return [x for v in value for x in _leaves(v)]
+    return [float(value)]
+
+
+def test_paper_numbers_load_from_the_data_file_each_with_its_source():
+    numbers = paper.load()  # the packaged experiments/data/paper.json
+    assert {"competence_all", "strategy_distance_1", "words_below_threshold"} <= set(numbers)
+    assert numbers["competence_all"].value == 0.46
+    assert numbers["median_names"].value == 0.23 and numbers["median_distractors"].value == 0.3
+    for number in numbers.values():
+        assert number.source.startswith("Forestier & Oudeyer 2017, section Results"), number
+        assert number.text and number.quote
+        # Every value is one the paper's own words state: an edit to one shows in the other.
+        for leaf in _leaves(number.value):
+            assert any(w in number.quote for w in _spellings(leaf)), (number.key, leaf)
+
+
+def test_a_paper_number_without_its_source_is_refused(tmp_path):
+    raw = json.loads(resources.files("experiments").joinpath("data", "paper.json").read_text())
+    del raw["numbers"]["median_names"]["source"]
+    path = tmp_path / "paper.json"
+    path.write_text(json.dumps(raw))
+    with pytest.raises(ValueError, match="median_names lacks source"):
+        paper.load(path)
+
+
+def _row(page: str, first_cell: str) -> list[str]:
+    """The cells (unescaped text) of the table row whose first cell starts with first_cell."""
+    for row in re.findall(r"<tr>(.*?)</tr>", page, flags=re.S):
+        cells = [html.unescape(c) for c in re.findall(r"<td>(.*?)</td>", row, flags=re.S)]
+        if cells and cells[0].startswith(first_cell):
+            return cells
+    raise AssertionError(f"no row {first_cell!r}")
+
+
+def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypatch):
+    results = collect(batches["kinematic"])
+    page = write_report(batches["kinematic"], tmp_path / "report").read_text()
+    published = paper.published()
+    result, theirs, ours = _row(page, "Normalised competence, all rings")
+    assert theirs == published["competence_all"].text == "46% better than random on average"
+    assert ours.startswith(f"{100 * results.trials['competence_all'].mean():.1f}% [95% CI ")
+    names = results.vocal.loc[results.vocal["is_name"], "best_distance"]
+    assert _row(page, "Median best distance, toy names")[1:] == ["0.23", f"{names.median():.2f}"]
+    # The paper column is read from the data file, not written into the code.
+    edited = dataclasses.replace(published["competence_all"], text="12% <b>edited</b>")
+    monkeypatch.setattr(paper, "published", lambda: {**published, "competence_all": edited})
+    page = write_report(batches["kinematic"], tmp_path / "edited").read_text()
+    assert _row(page, "Normalised competence, all rings")[1] == "12% <b>edited</b>"
+
+
+def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
+    batch = _copy_batch(batches, tmp_path / "<b>batch")
+    for config_path in batch.glob("*/config.json"):
+        config = json.loads(config_path.read_text())
+        config["trial"]["grasp"] = "<script>alert(1)</script>"
+        config_path.write_text(json.dumps(config))
+    text = write_report(batch, tmp_path / "out").read_text()
+    assert "<script>" not in text and "<b>batch" not in text
+    assert "this batch: &lt;script&gt;alert(1)&lt;/script&gt;" in text
+    assert "&lt;b&gt;batch" in text

@@ -15,8 +15,8 @@ import pytest
 from experiments import storage
 from experiments.cli import main
 from experiments.trial import CHECKPOINT_FILE, TrialSettings, read_log, run_trial
+from models.layout import SAMPLE_INDICES
 from sim import Playroom
-from sim.config import DEFAULT_WORLD
 from sim.dmp import arm_trajectory
 from sim.kinematics import hand_positions
 
@@ -103,7 +103,7 @@ def test_a_3000_iteration_run_learns_to_reach_hand_goals(trained_trial):
     learned, random_errors = [], []
     for _ in range(60):
         # A reachable goal: the hand trajectory of another random command, at the 5 samples.
-        joints = arm_trajectory(rng.uniform(-1, 1, 21))[:, list(DEFAULT_WORLD.sample_indices)]
+        joints = arm_trajectory(rng.uniform(-1, 1, 21))[:, list(SAMPLE_INDICES)]
         target = hand_positions(joints)  # (5, 2)
         goal = np.concatenate([target[:, 0], target[:, 1]])
         context = room.context()

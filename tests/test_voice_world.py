@@ -7,9 +7,9 @@ import pytest
 from scipy.io import wavfile
 
 from experiments.cli import main
+from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
-from sim.config import ARM_DIM, VOICE_DIM
 from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.produce import say
 from sim.vocal.words import word_distances, word_features

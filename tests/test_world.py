@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 from dm_control.rl import control
 
+from models.layout import ARM_BASIS_FUNCTIONS, ARM_DIM, N_STEPS, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
-from sim.config import ARM_DIM, DEFAULT_WORLD, VOICE_DIM
+from sim.config import DEFAULT_WORLD
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.kinematics import hand_positions
 from sim.physics import PlayroomPhysics
@@ -45,11 +46,11 @@ def test_zero_parameters_give_the_rest_trajectory():
 
 
 def test_end_parameter_sets_the_final_target():
-    m = np.zeros((3, DEFAULT_WORLD.arm_bfs + 1))
+    m = np.zeros((3, ARM_BASIS_FUNCTIONS + 1))
     m[:, -1] = [0.5, -0.3, 0.8]
     traj = arm_trajectory(m.ravel())
     np.testing.assert_allclose(traj[:, -1], np.pi * m[:, -1], atol=1e-3)
-    voice = np.zeros((7, DEFAULT_WORLD.voice_bfs + 2))
+    voice = np.zeros((7, VOICE_BASIS_FUNCTIONS + 2))
     voice[:, 0], voice[:, 1] = -0.4, 0.6
     np.testing.assert_allclose(voice_trajectory(voice.ravel())[:, -1], 0.6, atol=1e-3)
 
@@ -59,11 +60,11 @@ def test_dmp_output_is_bounded_deterministic_and_shaped():
     for _ in range(50):
         m = rng.uniform(-1, 1, ARM_DIM)
         traj = arm_trajectory(m)
-        assert traj.shape == (3, DEFAULT_WORLD.n_steps)
+        assert traj.shape == (3, N_STEPS)
         assert np.abs(traj).max() <= np.pi
         np.testing.assert_array_equal(traj, arm_trajectory(m.copy()))
         v = voice_trajectory(rng.uniform(-1, 1, VOICE_DIM))
-        assert v.shape == (7, DEFAULT_WORLD.n_steps) and np.abs(v).max() <= 1.0
+        assert v.shape == (7, N_STEPS) and np.abs(v).max() <= 1.0
 
 
 # The dm_control task ------------------------------------------------------------------------
@@ -186,9 +187,7 @@ def test_caregiver_brings_a_toy_toward_the_midpoint(grasp):
     room.caregiver.start_bringing(room.physics, 0)
     room.act_voice(np.zeros(VOICE_DIM))
     moved = room.context()[2:4] - start
-    expected = (1 - (1 - DEFAULT_WORLD.caregiver_bring_rate) ** DEFAULT_WORLD.n_steps) * (
-        target - start
-    )
+    expected = (1 - (1 - DEFAULT_WORLD.caregiver_bring_rate) ** N_STEPS) * (target - start)
     np.testing.assert_allclose(moved, expected, atol=0.03)
 
 

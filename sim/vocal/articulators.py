@@ -23,9 +23,9 @@ from pathlib import Path
 import numpy as np
 import vocaltractlab_cython as vtl
 
+from models.layout import N_ARTICULATORS
 from sim.vocal.config import DEFAULT_VOICE
 
-N_ARTICULATORS = DEFAULT_VOICE.n_articulators
 # The 5 study vowels first, then the 3 extra shapes that complete a 7-dimensional span.
 CORPUS_VOWELS: tuple[str, ...] = ("o", "u", "i", "e", "y", "a", "E", "2")
 # Every VTL vowel shape of the speaker, to report how much of the speaker's vowel space the

@@ -24,6 +24,8 @@ DEFAULT_PAD_S = 0.06  # s of held articulation before and after, for the pressur
 GLOTTIS_SHAPE = "modal"
 _PRESSURE_INDEX = 1  # "PR", lung pressure in dPa, in VTL's glottis parameter order
 _F0_INDEX = 0  # "F0", Hz
+# Peak of a lone sound written as WAV (fraction of full scale): loud, with room to spare.
+WAV_PEAK = 0.9
 
 
 def synthesise(
@@ -80,13 +82,28 @@ def synthesise_word(
     return synthesise(voice_trajectory(say(word)), duration_s=duration_s, pad_s=pad_s)
 
 
-def write_wav(path: str | Path, waveform: np.ndarray, rate: int) -> None:
-    """Write a mono float waveform as 16-bit PCM WAV, peak-normalised to 0.9 full scale
-    (VTL's output level depends on the articulation; silence stays silence)."""
-    wave = np.asarray(waveform, dtype=float).ravel()
+def write_wav(
+    path: str | Path, waveform: np.ndarray, rate: int, peak: float | None = WAV_PEAK
+) -> None:
+    """Write a mono float waveform as 16-bit PCM WAV: the one WAV writer of the project.
+
+    peak: the waveform is scaled to this peak (VTL's output level depends on the articulation,
+    so a lone word is normalised to be heard; silence stays silence). None keeps the levels,
+    as a mixed sound track needs, and clips to [-1, 1] so that the int16 conversion cannot wrap
+    a loud sample around to the opposite sign.
+    """
+    wave = np.asarray(waveform).ravel()
+    # A float32 track (the video's) stays float32: scaled in float64 instead, a sample at a
+    # rounding boundary could land one step away. Anything else becomes float64.
+    if wave.dtype not in (np.float32, np.float64):
+        wave = wave.astype(np.float64)
     if not np.all(np.isfinite(wave)):
         raise ValueError("waveform contains NaN or infinite values")
-    peak = float(np.max(np.abs(wave))) if wave.size else 0.0
-    if peak > 0:
-        wave = wave * (0.9 / peak)
-    wavfile.write(str(path), int(rate), np.round(wave * 32767).astype(np.int16))
+    if peak is not None:
+        if not 0 < peak <= 1:
+            raise ValueError(f"peak must be in (0, 1], got {peak}")
+        loudest = float(np.max(np.abs(wave))) if wave.size else 0.0
+        if loudest > 0:
+            wave = wave * (peak / loudest)
+    pcm = np.round(np.clip(wave, -1.0, 1.0) * 32767).astype(np.int16)
+    wavfile.write(str(path), int(rate), pcm)

@@ -1,4 +1,4 @@
-"""The study's vocal numbers (protocol.md, "Caregiver" and "Sensory feedback"), in one place."""
+"""The study's vocal numbers (docs/protocol.md §4, §6, §7), in one place."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class VoiceConfig:
-    # Vowels and words of the public implementation (protocol.md, "Caregiver").
+    # Vowels and words of the public implementation (docs/protocol.md §6).
     vowels: tuple[str, ...] = ("o", "u", "i", "e", "y")
     words: tuple[str, ...] = ("oey", "uye", "iuo", "eyu", "eou", "yeo")
     # The study's target formants (F1, F2) in Hz. Our targets are the VocalTractLab speaker's
@@ -21,13 +21,12 @@ class VoiceConfig:
         ("i", 300.0, 2300.0),
     )
     # Sound features: log2 F1 at the 5 sample points minus f1_offset, then log2 F2 minus
-    # f2_offset (protocol.md, "Sensory feedback"), in log2(Hz).
+    # f2_offset (docs/protocol.md §4), in log2(Hz).
     f1_offset: float = 8.5
     f2_offset: float = 10.25
     # The caregiver recognises a sound within this Euclidean distance of a word (10D space).
     recognition_distance: float = 0.4
     n_names: int = 3  # words that become toy names; the other 3 are distractors
-    n_articulators: int = 7
 
     @property
     def n_points(self) -> int:

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import lsq_linear, minimize
 
-from sim.config import DEFAULT_WORLD, VOICE_DIM, WorldConfig
+from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_BASIS_FUNCTIONS, VOICE_DIM
+from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import rollout
 from sim.vocal.tract import VocalTract
 from sim.vocal.words import word_features
@@ -31,11 +32,11 @@ START_NOISE = 0.2  # std of the perturbations, in parameter units
 
 
 def dmp_response(world: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
-    """(2 + voice_bfs, n_steps): the articulator trajectory of each unit parameter (start,
-    end, each weight in [-1, 1] units), before clipping. The DMP is linear in them."""
-    n_in = 2 + world.voice_bfs
+    """(2 + VOICE_BASIS_FUNCTIONS, N_STEPS): the articulator trajectory of each unit parameter
+    (start, end, each weight in [-1, 1] units), before clipping. The DMP is linear in them."""
+    n_in = 2 + VOICE_BASIS_FUNCTIONS
     eye = np.eye(n_in)
-    return rollout(eye[:, 0], eye[:, 1], eye[:, 2:] * world.dmp_weight_scale, world.n_steps)
+    return rollout(eye[:, 0], eye[:, 1], eye[:, 2:] * world.dmp_weight_scale, N_STEPS)
 
 
 def initial_guess(word: str, tract: VocalTract) -> np.ndarray:
@@ -44,7 +45,7 @@ def initial_guess(word: str, tract: VocalTract) -> np.ndarray:
     art = tract.articulators
     v1, v2, v3 = (art.vowel(c) for c in word)
     points = np.stack([v1, (v1 + v2) / 2, v2, (v2 + v3) / 2, v3])  # (5, 7)
-    resp = dmp_response(tract.world)[:, list(tract.world.sample_indices)].T  # (5, 4)
+    resp = dmp_response(tract.world)[:, list(SAMPLE_INDICES)].T  # (5, 4)
     per_art = [lsq_linear(resp, points[:, k], bounds=(-1.0, 1.0)).x for k in range(7)]
     return np.concatenate(per_art)  # per articulator: start, end, weights (sim.dmp layout)
 

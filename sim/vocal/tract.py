@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.config import DEFAULT_WORLD, VOICE_DIM, WorldConfig
+from models.layout import N_ARTICULATORS, SAMPLE_INDICES, VOICE_DIM
+from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import voice_trajectory
 from sim.vocal.articulators import ArticulatorModel, default_articulators
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
@@ -52,15 +53,14 @@ class VocalTract:
         self.articulators = default_articulators() if articulators is None else articulators
         self.formant_map = default_formant_map() if formant_map is None else formant_map
         self.n_fallbacks = 0  # exact-path frames that got the fallback value
-        self._sample_idx = np.array(world.sample_indices)
+        self._sample_idx = np.array(SAMPLE_INDICES)
 
     def formants(self, artic: np.ndarray) -> np.ndarray:
         """Articulator values (..., 7) in [-1, 1] -> (..., 2) log2 Hz (F1, F2)."""
         artic = np.asarray(artic, dtype=float)
-        if artic.ndim == 0 or artic.shape[-1] != self.config.n_articulators:
+        if artic.ndim == 0 or artic.shape[-1] != N_ARTICULATORS:
             raise ValueError(
-                f"articulators must have shape (..., {self.config.n_articulators}); "
-                f"got {artic.shape}"
+                f"articulators must have shape (..., {N_ARTICULATORS}); got {artic.shape}"
             )
         _check_box(artic, "articulators")
         if not self.exact:
@@ -81,9 +81,9 @@ class VocalTract:
         """(7, n_steps) articulator trajectory -> (n_steps, 2) log2 Hz, one row per control
         step (what the sound sensor reads at each step)."""
         artic_traj = np.asarray(artic_traj, dtype=float)
-        if artic_traj.ndim != 2 or artic_traj.shape[0] != self.config.n_articulators:
+        if artic_traj.ndim != 2 or artic_traj.shape[0] != N_ARTICULATORS:
             raise ValueError(
-                f"articulator trajectory must have shape ({self.config.n_articulators}, "
+                f"articulator trajectory must have shape ({N_ARTICULATORS}, "
                 f"n_steps); got {artic_traj.shape}"
             )
         return self.formants(artic_traj.T)
