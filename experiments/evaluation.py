@@ -1,4 +1,4 @@
-"""Evaluation of a trial after learning (protocol.md, "Evaluation after learning").
+"""Evaluation of a trial after learning (docs/protocol.md §10).
 
 Competence: for each ring and each of `n_placements` seeded placements of the 3 toys in that
 ring, and for each toy, the goal is the toy moved straight to the arm's base, sampled at
@@ -35,7 +35,7 @@ from sim.vocal.config import DEFAULT_VOICE
 EVAL_FILE = "eval.json"
 COMPETENCE_FILE = "competence.parquet"
 VOCAL_FILE = "vocal.parquet"
-# Times at which the goal trajectory samples the toy's way to the centre (protocol.md).
+# Times at which the goal trajectory samples the toy's way to the centre (docs/protocol.md §10).
 GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
 # Evaluation placements come from their own seed, the same for every trial and backend, so
 # that trials are compared on identical tests.
@@ -74,7 +74,7 @@ def placements(
 
 
 def strategy_of(motor_space: str, stick_moved: bool) -> str:
-    """hand (arm, stick still), tool (arm, stick moved) or vocal (voice): protocol.md."""
+    """hand (arm, stick still), tool (arm, stick moved) or vocal (voice): docs/protocol.md §10."""
     if motor_space == "voice":
         return "vocal"
     return "tool" if stick_moved else "hand"

@@ -1,15 +1,6 @@
 """One trial: the Model Babbling agent playing in one room, written to a directory that
-survives being killed.
+survives being killed (its files: experiments/trial_files.py).
 
-A trial directory holds:
-- `config.json`: every setting (trial, world, voice, learner), the package version, the seed;
-- `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
-  every `checkpoint_every` iterations and at the end, with the one before it kept beside it
-  as `checkpoint.prev.npz`: a damaged newest checkpoint costs at most two periods;
-- `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
-  one file per checkpoint period, starting at iteration NNNNNNNN;
-- `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
-  of the 6 words.
 Each file is written atomically, and a log chunk is always written before the checkpoint that
 covers it, so a run killed at any moment resumes from its last checkpoint and rewrites the same
 chunks: the final memory and logs equal those of an uninterrupted run.
@@ -38,40 +29,31 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
-from learner.agent import Agent
+from experiments.trial_files import (  # noqa: F401 (the trial's files are read from here too)
+    CHECKPOINT_FILE,
+    CONFIG_FILE,
+    DAMAGED_CHECKPOINT_FILE,
+    LOG_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+    STALE_PREFIX,
+    TRIAL_ENTRIES,
+    TrialError,
+    TrialLocked,
+    fresh_trial_parts,
+    load_trial,
+    log_row,
+    read_log,
+    restore_checkpoint,
+)
 from learner.config import LearnerConfig
 from models.layout import TOYS, block_slice
-from sim import Playroom
-from sim import events as ev
-from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict
+from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
 
-CONFIG_FILE = "config.json"
-CHECKPOINT_FILE = "checkpoint.npz"
-PREVIOUS_CHECKPOINT_FILE = "checkpoint.prev.npz"
-# Where a damaged newest checkpoint is kept when a resume falls back past it.
-DAMAGED_CHECKPOINT_FILE = "checkpoint.damaged.npz"
-LOG_DIR = "log"
-# What a trial directory holds of the trial itself; everything else in it (evaluation, timing,
-# videos) was derived from the trial at some iteration and goes stale when it is extended.
-TRIAL_ENTRIES = (
-    CONFIG_FILE,
-    CHECKPOINT_FILE,
-    PREVIOUS_CHECKPOINT_FILE,
-    DAMAGED_CHECKPOINT_FILE,
-    LOG_DIR,
-    LOCK_FILE,
-)
-STALE_PREFIX = "stale-at-"
-# Iterations between two rows of the words log (issue 4: "every 100 iterations").
+# Iterations between two rows of the words log: the vocal learning curves are read every 100
+# iterations (docs/protocol.md §10).
 WORDS_LOG_PERIOD = 100
-# The agent's random generator is seeded apart from the room's, from the same trial seed.
-AGENT_STREAM = 1
-
-
-class TrialError(Exception):
-    """A trial directory or setting that cannot be used; the message says why."""
 
 
 @dataclass(frozen=True)
@@ -117,10 +99,6 @@ def full_config(
 
 # Settings a resume may change: a trial can be extended to more iterations.
 EXTENSIBLE = ("trial.iterations",)
-
-
-class TrialLocked(TrialError):
-    """Another process is writing into the trial directory."""
 
 
 class Trial:
@@ -328,100 +306,6 @@ class Trial:
         storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
         if word_rows:
             storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
-
-
-def log_row(iteration: int, proposal, feedback) -> dict:
-    """One row of the iterations log: what was tried and what happened."""
-    row = {
-        "iteration": iteration,
-        "motor_space": proposal.motor_space,
-        "model": -1 if proposal.model is None else int(proposal.model),
-        "stick_grasped": False,
-        "stick_moved_by": "",
-        **{f"{toy}_moved_by": "" for toy in TOYS},
-        "word_recognised": "",
-        "caregiver_said": "",
-        "diverged": False,
-    }
-    for e in feedback.events:
-        if e.kind == ev.STICK_GRASPED:
-            row["stick_grasped"] = True
-        elif e.kind == ev.STICK_MOVED:
-            row["stick_moved_by"] = e.by
-        elif e.kind == ev.TOY_MOVED:
-            row[f"{e.obj}_moved_by"] = e.by
-        elif e.kind == ev.WORD_RECOGNISED:
-            row["word_recognised"] = e.word
-        elif e.kind == ev.CAREGIVER_SAID:
-            row["caregiver_said"] = e.word
-        elif e.kind == ev.DIVERGED:
-            row["diverged"] = True
-    return row
-
-
-def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
-    """The agent and room of a trial's iteration 0, as its config makes them."""
-    settings = config["trial"]
-    room = Playroom(
-        grasp=settings["grasp"],
-        seed=settings["seed"],
-        config=config_from_dict(WorldConfig, config["world"]),
-        voice=config_from_dict(VoiceConfig, config["voice"]),
-    )
-    agent = Agent(
-        LearnerConfig.from_dict(config["learner"]),
-        np.random.default_rng([settings["seed"], AGENT_STREAM]),
-    )
-    return agent, room
-
-
-def restore_checkpoint(
-    trial_dir: str | os.PathLike, agent: Agent, room: Playroom, name: str = CHECKPOINT_FILE
-) -> dict:
-    """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
-    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored."""
-    path = Path(trial_dir) / name
-    if not path.exists():
-        raise storage.CorruptFileError(f"{path} is missing")
-    arrays, meta = storage.read_arrays(path)
-    try:
-        agent_state = {
-            k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")
-        }
-        agent.load_state_dict(agent_state)
-        room.set_state({**meta["room"], "physics": arrays["room/physics"]})
-        meta["best_word_distance"] = arrays["best_word_distance"].copy()
-    except (KeyError, ValueError, TypeError) as exc:
-        raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
-    return meta
-
-
-def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
-    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta)."""
-    trial_dir = Path(trial_dir)
-    if not (trial_dir / CONFIG_FILE).exists():
-        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
-        raise TrialError(f"{trial_dir} has no checkpoint yet")
-    config = storage.read_json(trial_dir / CONFIG_FILE)
-    agent, room = fresh_trial_parts(config)
-    try:
-        meta = restore_checkpoint(trial_dir, agent, room)
-    except storage.CorruptFileError as exc:
-        if (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
-            raise storage.CorruptFileError(
-                f"{exc}; `playroom run --resume` continues from the previous checkpoint"
-            ) from None
-        raise
-    return config, agent, room, meta
-
-
-def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:
-    """All chunks of one log ('iterations' or 'words') of a trial, in order."""
-    chunks = sorted((Path(trial_dir) / LOG_DIR).glob(f"{kind}-*.parquet"))
-    if not chunks:
-        return pd.DataFrame()
-    return pd.concat([storage.read_table(c) for c in chunks], ignore_index=True)
 
 
 def run_trial(

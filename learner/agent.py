@@ -1,4 +1,4 @@
-"""The Model Babbling agent (protocol.md, "Learning"): bootstrap, goals, imitation, learning.
+"""The Model Babbling agent (docs/protocol.md §9): bootstrap, goals, imitation, learning.
 
 One iteration is `agent.play(world)`: `proposal = agent.propose(context)`, the world executes
 `proposal.m` with the arm or the voice, then `agent.learn(proposal, context, s)` with the

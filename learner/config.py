@@ -1,10 +1,10 @@
-"""Every learning number of the study (protocol.md, "Learning (Model Babbling)"), in one place.
+"""Every learning number of the study (docs/protocol.md §9), in one place.
 
 The learner sees vectors only, so its units are those of the vectors: motor commands and
 sensory goals live in [-1, 1]; positions in the sensory feedback are in the paper's length
-units (metres in the MJCF model); sounds are in normalised log2-Hz (protocol.md, "Sensory
-feedback"). The 10 sensorimotor models (which motor space, context and sensory dimensions each
-uses) are the table `models.layout.MODELS`, with every size of the vectors.
+units (metres in the MJCF model); sounds are in normalised log2-Hz (docs/protocol.md §4). The
+10 sensorimotor models (which motor space, context and sensory dimensions each uses) are the
+table `models.layout.MODELS`, with every size of the vectors.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ class LearnerConfig:
     # Motor commands live in [motor_low, motor_high] (their sizes: models/layout.py).
     motor_low: float = -1.0
     motor_high: float = 1.0
-    # Bootstrap (protocol.md): random commands before any goal babbling, in shuffled order.
+    # Bootstrap (docs/protocol.md §9): random commands before any goal babbling, in shuffled order.
     bootstrap_arm: int = 500  # commands
     bootstrap_voice: int = 500  # commands
     # Goal babbling: goals are drawn uniformly in [goal_low, goal_high]^10 of a sensory space.
@@ -40,7 +40,7 @@ class LearnerConfig:
     # Attempts per half-window of the progress measure (learner.interest). Not a number of the
     # protocol: the public implementation smoothed progress over about 1000 attempts instead.
     progress_window: int = 100  # attempts of one model
-    # Imitation by model 10 (protocol.md, "Learning"): share of its goals that are caregiver
+    # Imitation by model 10 (docs/protocol.md §9): share of its goals that are caregiver
     # sounds, drawn from the last `imitation_memory` sounds heard after arm movements.
     imitation_share: float = 0.5
     imitation_memory: int = 100  # sounds

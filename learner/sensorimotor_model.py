@@ -1,11 +1,12 @@
 """Sensorimotor models: one arrow of the paper's Fig. 2, motor space -> sensory block | context.
 
 A model keeps the experiences (m, c_i, s_i) of its motor space whose sensory block changed,
-and answers, by nearest neighbour (protocol.md, "Learning"):
+and answers, by nearest neighbour (docs/protocol.md §8):
 - inverse: the motor command m of the stored (c_i, s_i) nearest to (context, goal);
 - forward: the sensory block s_i of the stored (m, c_i) nearest to (command, context).
 
-Storing rule (protocol.md: "only when its sensory part changed during the movement"):
+Storing rule (the paper: "only when its sensory part changed"; the study's code differs,
+docs/protocol.md §11):
 - a block with a start position in the context (stick handle, toy i) changed when one of its
   5 x, 5 y samples is more than `change_tolerance` from that start position. The context is
   the position before the movement, so a toy grabbed before the first sample (step 1 of 50)

@@ -9,6 +9,8 @@ backend the toy is placed directly, as in the study.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 
@@ -17,11 +19,31 @@ from sim import events as ev
 from sim.config import WorldConfig
 from sim.model_edits import ModelEdits
 from sim.physics import OBJECTS, PlayroomPhysics
+from sim.vocal.config import VoiceConfig
 from sim.vocal.tract import VocalTract
-from sim.vocal.words import WordAssignment, assign_words, word_features
+from sim.vocal.words import word_features
 
 # The name under which she edits the model (sim/model_edits.py).
 OWNER = "caregiver"
+
+
+@dataclass(frozen=True)
+class WordAssignment:
+    """One run's words: names[i] is the name of toy i+1; distractors are the other 3."""
+
+    names: tuple[str, ...]
+    distractors: tuple[str, ...]
+
+    def toy_of(self, word: str) -> int | None:
+        """0-based index of the toy a word names, or None for a distractor."""
+        return self.names.index(word) if word in self.names else None
+
+
+def assign_words(rng: np.random.Generator, config: VoiceConfig) -> WordAssignment:
+    """Shuffle the 6 words with rng: the first n_names name the toys, the rest are distractors."""
+    order = rng.permutation(len(config.words))
+    words = tuple(config.words[i] for i in order)
+    return WordAssignment(names=words[: config.n_names], distractors=words[config.n_names :])
 
 
 class Caregiver:

@@ -83,7 +83,7 @@ def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.nda
     """21 arm parameters in [-1, 1] -> (3, n_steps) joint angles in rad, relative to rest.
 
     Per joint: `ARM_BASIS_FUNCTIONS` weights then 1 end position. The DMP starts at rest (0); the
-    trajectory is bounded to [-1, 1] and scaled by pi (protocol.md).
+    trajectory is bounded to [-1, 1] and scaled by pi (docs/protocol.md §2).
     """
     per_joint = np.asarray(m, dtype=float).reshape(N_JOINTS, ARM_BASIS_FUNCTIONS + 1)
     weights = per_joint[:, :-1] * config.dmp_weight_scale
@@ -94,7 +94,7 @@ def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.nda
 def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
     """28 voice parameters in [-1, 1] -> (7, n_steps) articulator values in [-1, 1].
 
-    Per articulator: start, end, then `VOICE_BASIS_FUNCTIONS` weights (protocol.md).
+    Per articulator: start, end, then `VOICE_BASIS_FUNCTIONS` weights (docs/protocol.md §2).
     """
     per_art = np.asarray(m, dtype=float).reshape(N_ARTICULATORS, VOICE_BASIS_FUNCTIONS + 2)
     weights = per_art[:, 2:] * config.dmp_weight_scale

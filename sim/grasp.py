@@ -67,8 +67,8 @@ def _arm_to_rest(physics: PlayroomPhysics) -> None:
 
 
 class KinematicGrasp(GraspBackend):
-    """The study's rules (protocol.md): the arm follows its targets exactly and objects attach
-    by distance. Held objects are placed, not simulated."""
+    """The study's rules (docs/protocol.md §5; the catch rule departs, §11): the arm follows its
+    targets exactly and objects attach by distance. Held objects are placed, not simulated."""
 
     name = "kinematic"
 

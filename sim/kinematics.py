@@ -1,4 +1,4 @@
-"""The arm's analytic forward kinematics (protocol.md), used to check the MJCF model and to
+"""The arm's analytic forward kinematics (docs/protocol.md §1), used to check the MJCF model and to
 plan scripted commands without running the physics."""
 
 from __future__ import annotations

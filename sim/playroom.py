@@ -23,7 +23,7 @@ from models.layout import (
 )
 from models.world import Feedback
 from sim import events as ev
-from sim.caregiver import Caregiver
+from sim.caregiver import Caregiver, WordAssignment
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.grasp import BACKENDS, make_backend
@@ -32,7 +32,6 @@ from sim.physics import CONTROL_SUBSTEPS, KinematicPhysics, PlayroomPhysics
 from sim.task import ARM, VOICE, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.tract import VocalTract
-from sim.vocal.words import WordAssignment
 
 # Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
 RANGE_TOLERANCE = 1e-9
@@ -103,7 +102,7 @@ class Playroom:
         raise ValueError(f"unknown motor space {motor_space!r}: 'arm' or 'voice'")
 
     def act_arm(self, m: np.ndarray) -> Feedback:
-        """Execute 21 arm parameters in [-1, 1] (protocol.md) and return the feedback.
+        """Execute 21 arm parameters in [-1, 1] (docs/protocol.md §2) and return the feedback.
 
         Afterwards the caregiver says the name of the toy in the hand, or else a random
         distractor: her word is the sound block s[50:60].
@@ -114,7 +113,7 @@ class Playroom:
         return self._run(ARM, actions)
 
     def act_voice(self, m: np.ndarray) -> Feedback:
-        """Execute 28 vocal parameters in [-1, 1] (protocol.md) and return the feedback.
+        """Execute 28 vocal parameters in [-1, 1] (docs/protocol.md §2) and return the feedback.
 
         The sound block s[50:60] is the agent's own sound. If the caregiver recognises a toy's
         name in it, she brings that toy toward the midpoint between her and the arm's base

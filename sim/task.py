@@ -29,8 +29,8 @@ class PlayroomTask(control.Task):
 
     `vocal_tract` is the voice (sim.vocal.VocalTract): its `formants(articulators)` gives log2
     (F1, F2) of the current articulators. The `sound` observation is those formants normalised
-    as in protocol.md (log2 F1 - 8.5, log2 F2 - 10.25) while the agent speaks, the caregiver's
-    word once she speaks, and zeros in silence.
+    as in docs/protocol.md §4 (log2 F1 - 8.5, log2 F2 - 10.25) while the agent speaks, the
+    caregiver's word once she speaks, and zeros in silence.
     """
 
     def __init__(self, grasp: GraspBackend, caregiver: Caregiver, vocal_tract=None) -> None:

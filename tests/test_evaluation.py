@@ -1,4 +1,4 @@
-"""Evaluation after learning (protocol.md): goals, strategies, the random reference."""
+"""Evaluation after learning (docs/protocol.md §10): goals, strategies, the random reference."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Refactoring changes no behaviour: a 2000-iteration trial of each backend gives the logs it
-gave when they were recorded (tests/data, recorded 2026-11-22 before the module split of
-issue 10 by running the same settings)."""
+gave when they were recorded (tests/data, recorded 2026-11-22, before the code was reorganised into
+models/layout.py, one loop and one caregiver, by running the same settings)."""
 
 from __future__ import annotations
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import vocaltractlab_cython as vtl
 
+from sim.caregiver import assign_words
 from sim.dmp import voice_trajectory
 from sim.vocal import formants as formants_mod
 from sim.vocal.articulators import default_articulators, speaker_shapes
@@ -15,7 +16,6 @@ from sim.vocal.formants import FALLBACK_HZ, tract_formants, tube_formants
 from sim.vocal.produce import say, stored_distances
 from sim.vocal.tract import VocalTract
 from sim.vocal.words import (
-    assign_words,
     recognise,
     vowel_targets,
     word_distances,
@@ -147,13 +147,13 @@ def test_word_features_layout() -> None:
 
 
 def test_word_assignment_per_seed() -> None:
-    a = assign_words(np.random.default_rng(3))
-    b = assign_words(np.random.default_rng(3))
+    a = assign_words(np.random.default_rng(3), DEFAULT_VOICE)
+    b = assign_words(np.random.default_rng(3), DEFAULT_VOICE)
     assert a == b
     assert len(a.names) == 3 and len(a.distractors) == 3
     assert sorted(a.names + a.distractors) == sorted(DEFAULT_VOICE.words)
     assert a.toy_of(a.names[1]) == 1 and a.toy_of(a.distractors[0]) is None
-    seen = {assign_words(np.random.default_rng(s)).names for s in range(20)}
+    seen = {assign_words(np.random.default_rng(s), DEFAULT_VOICE).names for s in range(20)}
     assert len(seen) > 1
 
 

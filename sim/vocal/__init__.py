@@ -1,7 +1,7 @@
 """The agent's voice: a DIVA-style vocal tract built on VocalTractLab (no MuJoCo in here).
 
 Modules, one concept each:
-- `config`: the study's vocal numbers (protocol.md) in `VoiceConfig`.
+- `config`: the study's vocal numbers (docs/protocol.md §6, §7) in `VoiceConfig`.
 - `articulators`: 7 PCA articulators in [-1, 1] -> 19 VocalTractLab tract parameters.
 - `formants`: exact formants (VTL area function + lossless-tube resonances).
 - `formant_map`: the fast fitted map articulators -> (log2 F1, log2 F2), plain NumPy.

@@ -4,7 +4,7 @@ Articulator values (7 per frame) in [-1, 1] go to formants (log2 Hz) either thro
 fitted map (default; microseconds per movement) or the exact path (VocalTractLab area function
 and lossless-tube resonances; about 5 ms per frame). A 28-parameter vocal command goes through
 the vocal DMP (`sim.dmp.voice_trajectory`) to a (7, 50) articulator trajectory, whose formants
-at the 5 sample steps are the 10D sound features (protocol.md).
+at the 5 sample steps are the 10D sound features (docs/protocol.md §4).
 """
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ class VocalTract:
         return normalise(np.asarray(step_formants)[self._sample_idx], self.config)
 
     def sound_features(self, m: np.ndarray) -> np.ndarray:
-        """28 voice parameters -> (10,) normalised sound features (protocol.md).
+        """28 voice parameters -> (10,) normalised sound features (docs/protocol.md §4).
 
         Only the 5 sample steps go through the formant model.
         """

@@ -7,13 +7,12 @@ computed once by `fit_voice_model` and stored in data/vowels.npz; the study's Hz
 
 A word of 3 vowels is a 5-point formant trajectory: v1, mid(v1, v2), v2, mid(v2, v3), v3, in
 log2 Hz, midpoints taken in log2. Its 10D sound features are the 5 log2 F1 values minus
-f1_offset, then the 5 log2 F2 values minus f2_offset (protocol.md).
+f1_offset, then the 5 log2 F2 values minus f2_offset (docs/protocol.md §4, §6).
 """
 
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -108,22 +107,3 @@ def recognise(features: np.ndarray, config: VoiceConfig = DEFAULT_VOICE) -> str 
     dist = word_distances(features, config)
     best = int(np.argmin(dist))
     return config.words[best] if dist[best] < config.recognition_distance else None
-
-
-@dataclass(frozen=True)
-class WordAssignment:
-    """One run's words: names[i] is the name of toy i+1; distractors are the other 3."""
-
-    names: tuple[str, ...]
-    distractors: tuple[str, ...]
-
-    def toy_of(self, word: str) -> int | None:
-        """0-based index of the toy a word names, or None for a distractor."""
-        return self.names.index(word) if word in self.names else None
-
-
-def assign_words(rng: np.random.Generator, config: VoiceConfig = DEFAULT_VOICE) -> WordAssignment:
-    """Shuffle the 6 words with rng: the first n_names name the toys, the rest are distractors."""
-    order = rng.permutation(len(config.words))
-    words = tuple(config.words[i] for i in order)
-    return WordAssignment(names=words[: config.n_names], distractors=words[config.n_names :])
