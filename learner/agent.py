@@ -31,12 +31,13 @@ from numpy.typing import ArrayLike
 
 from learner.config import LearnerConfig
 from learner.interest import InterestModel
-from learner.sensorimotor_model import SensorimotorModel
+from learner.sensorimotor_model import SensorimotorModel, changed_blocks
 from models.layout import (
     BLOCK_DIM,
     CONTEXT_DIM,
     MODELS,
     MOTOR_DIMS,
+    SENSORY_BLOCKS,
     SENSORY_DIM,
     ModelSpec,
     block_slice,
@@ -75,6 +76,7 @@ class Agent:
             space: [k for k, spec in enumerate(self.specs) if spec.motor_space == space]
             for space in _SPACE_CODE
         }
+        self._block_of = [SENSORY_BLOCKS.index(spec.sensory_block) for spec in self.specs]
         self.interest = InterestModel(len(self.specs), self.config)
         cfg = self.config
         order = np.repeat(np.array([0, 1], dtype=np.int8), [cfg.bootstrap_arm, cfg.bootstrap_voice])
@@ -144,8 +146,10 @@ class Agent:
         context = self._check_context(context)
         s = _checked_vector(s, SENSORY_DIM, "feedback s")
         m = proposal.m
+        changed = changed_blocks(context, s, self.config.change_tolerance)
         for k in self._by_space[proposal.motor_space]:
-            self.models[k].update(m, context, s)
+            if changed[self._block_of[k]]:
+                self.models[k].store(m, context, s)
         if proposal.model is not None:
             reached = s[self.models[proposal.model].sensory_slice]
             self.interest.update(proposal.model, proposal.goal, reached)

@@ -69,12 +69,13 @@ class InterestModel:
         k = self._attempts[model]
         self._competences[model, k % (2 * self.window)] = value
         self._attempts[model] = k + 1
-        self._progress[model] = self._model_progress(model)
+        if self.mode == "active":  # only active choice reads it on every iteration
+            self._progress[model] = self._model_progress(model)
         return value
 
     def progress(self) -> np.ndarray:
         """Progress of each model (n_models,), as defined in the module docstring."""
-        return self._progress.copy()
+        return np.array([self._model_progress(k) for k in range(self.n_models)])
 
     def _model_progress(self, model: int) -> float:
         n = int(self._attempts[model])

@@ -89,13 +89,15 @@ class NearestNeighbourMemory:
         view.flags.writeable = False
         return view
 
-    def append(self, row: ArrayLike) -> None:
-        """Add one row (dim,). Raises ValueError on a wrong shape or a non-finite value."""
-        row = np.asarray(row, dtype=np.float64)
-        if row.shape != (self._dim,):
-            raise ValueError(f"memory row must have shape ({self._dim},), got {row.shape}")
-        if not np.isfinite(row).all():
-            raise ValueError("memory row has a NaN or infinite value")
+    def append(self, row: ArrayLike, checked: bool = False) -> None:
+        """Add one row (dim,). Raises ValueError on a wrong shape or a non-finite value, unless
+        the caller has `checked` the row already (a float64 array of finite values)."""
+        if not checked:
+            row = np.asarray(row, dtype=np.float64)
+            if row.shape != (self._dim,):
+                raise ValueError(f"memory row must have shape ({self._dim},), got {row.shape}")
+            if not np.isfinite(row).all():
+                raise ValueError("memory row has a NaN or infinite value")
         if self._n == self._rows.shape[0]:
             self._reserve(self._n + 1)
         n = self._n
@@ -155,10 +157,11 @@ class NearestNeighbourMemory:
         err = 2.0 * (self._dim + 4) * _F32_UNIT_ROUNDOFF
         err *= 0.5 * self._max_sq_norm + math.sqrt(self._max_sq_norm) * math.sqrt(q @ q)
         below = np.less_equal(screened, screened[best] + 2.0 * err, out=self._below[:n])
+        # Usually the best row is alone within the bound: counting is one fast pass, and the
+        # candidates' indices are gathered only when there are several.
+        if np.count_nonzero(below) == 1:
+            return best, float(np.sqrt(squared_distances(self._rows[best : best + 1], q)[0]))
         candidates = np.flatnonzero(below)
-        if candidates.size == 1:
-            i = int(candidates[0])
-            return i, float(np.sqrt(squared_distances(self._rows[i : i + 1], q)[0]))
         sq = squared_distances(self._rows[candidates], q)
         j = int(np.argmin(sq))
         return int(candidates[j]), float(np.sqrt(sq[j]))

@@ -31,13 +31,48 @@ from models.layout import (
     MODELS,
     MOTOR_DIMS,
     N_SAMPLES,
+    SENSORY_BLOCKS,
+    SENSORY_DIM,
     ModelSpec,
+    block_slice,
     context_indices,
 )
 
 __all__ = ["MODELS", "ModelSpec", "SensorimotorModel"]
 
 _INITIAL_CAPACITY = 1024  # rows preallocated per model, doubled when full
+
+
+def _reference_indices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Where each value of s (60,) is compared to by the storing rule: (destination in s,
+    source in the context) for blocks whose start is in the context, and (destination, source
+    in s) for the hand, compared with its first sample. The sound is compared with 0."""
+    ctx_dst, ctx_src, s_dst, s_src = [], [], [], []
+    for block in SENSORY_BLOCKS:
+        if block == "sound":
+            continue
+        dims = np.arange(SENSORY_DIM)[block_slice(block)].reshape(2, N_SAMPLES)  # x row, y row
+        if block in CONTEXT_SLOTS:
+            for axis, start in enumerate(context_indices(block)):
+                ctx_dst += dims[axis].tolist()
+                ctx_src += [start] * N_SAMPLES
+        else:
+            for axis in range(2):
+                s_dst += dims[axis].tolist()
+                s_src += [dims[axis, 0]] * N_SAMPLES
+    return tuple(np.array(a, dtype=np.intp) for a in (ctx_dst, ctx_src, s_dst, s_src))
+
+
+_CTX_DST, _CTX_SRC, _S_DST, _S_SRC = _reference_indices()
+
+
+def changed_blocks(context: np.ndarray, s: np.ndarray, tolerance: float) -> np.ndarray:
+    """The storing rule (module docstring) for every block of SENSORY_BLOCKS at once: (6,)
+    bool, from a context (10,) and feedback (60,)."""
+    reference = np.zeros(SENSORY_DIM)
+    reference[_CTX_DST] = context[_CTX_SRC]
+    reference[_S_DST] = s[_S_SRC]
+    return (np.abs(s - reference) > tolerance).reshape(len(SENSORY_BLOCKS), BLOCK_DIM).any(axis=1)
 
 
 class SensorimotorModel:
@@ -50,10 +85,7 @@ class SensorimotorModel:
         self.sensory_slice = spec.sensory_slice
         self.sensory_dim = BLOCK_DIM
         self._tolerance = config.change_tolerance
-        # Where the block's object was before the movement, if the context says it.
-        has_start = spec.sensory_block in CONTEXT_SLOTS
-        start = context_indices(spec.sensory_block) if has_start else None
-        self._start_dims = None if start is None else np.array(start, dtype=np.intp)
+        self._block = SENSORY_BLOCKS.index(spec.sensory_block)
         c_dim = len(self.context_dims)
         self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
         self._n = 0
@@ -82,15 +114,7 @@ class SensorimotorModel:
 
     def sensory_changed(self, context: np.ndarray, s: np.ndarray) -> bool:
         """The storing rule (module docstring), for a full context (10,) and feedback (60,)."""
-        block = s[self.sensory_slice]
-        if self.spec.sensory_block == "sound":
-            return bool(np.any(np.abs(block) > self._tolerance))
-        xy = block.reshape(2, N_SAMPLES)  # row 0: x samples, row 1: y samples
-        if self._start_dims is not None:
-            start = context[self._start_dims][:, None]
-        else:
-            start = xy[:, :1]
-        return bool(np.any(np.abs(xy - start) > self._tolerance))
+        return bool(changed_blocks(context, s, self._tolerance)[self._block])
 
     def update(self, m: np.ndarray, context: np.ndarray, s: np.ndarray) -> bool:
         """Store (m, c_i, s_i) if the sensory block changed; return whether it was stored.
@@ -99,12 +123,16 @@ class SensorimotorModel:
         """
         if not self.sensory_changed(context, s):
             return False
+        self.store(m, context, s)
+        return True
+
+    def store(self, m: np.ndarray, context: np.ndarray, s: np.ndarray) -> None:
+        """Store (m, c_i, s_i) without the storing rule, from checked, finite vectors."""
         c_i = context[self.context_dims]
-        self._inverse.append(np.concatenate((c_i, s[self.sensory_slice])))
+        self._inverse.append(np.concatenate((c_i, s[self.sensory_slice])), checked=True)
         self._append_motor(m[None, :])
         if self._forward is not None:
-            self._forward.append(np.concatenate((m, c_i)))
-        return True
+            self._forward.append(np.concatenate((m, c_i)), checked=True)
 
     def extend(self, motor: ArrayLike, context: ArrayLike, sensory: ArrayLike) -> None:
         """Store k experiences at once, without the storing rule (loading, benchmarks).

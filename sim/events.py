@@ -4,6 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
+from models.layout import MOVED_DISTANCE, TRACKED_OBJECTS
+
 # Event kinds, in one place so logs, tests and overlays agree on the spelling.
 STICK_GRASPED = "stick_grasped"  # the hand took the stick by its handle
 TOY_GRASPED = "toy_grasped"  # the hand took a toy (obj = toy)
@@ -37,3 +41,27 @@ class Event:
     obj: str | None = None
     by: str | None = None
     word: str | None = None
+
+
+def movement_events(
+    positions: np.ndarray, step_events: list[Event], brought: str | None
+) -> list[Event]:
+    """Which objects moved, when first, and by what, from (51, 5, 2) positions (row 0 = start)."""
+    grasped = {e.obj for e in step_events if e.kind in (TOY_GRASPED, STICK_GRASPED)}
+    caught = {e.obj for e in step_events if e.kind == TOY_CAUGHT}
+    moved: list[Event] = []
+    displacement = np.linalg.norm(positions - positions[0], axis=2)  # (51, 5)
+    for row, name in enumerate(TRACKED_OBJECTS[1:], start=1):
+        steps = np.flatnonzero(displacement[:, row] > MOVED_DISTANCE)
+        if steps.size == 0:
+            continue
+        if name == "stick":
+            by = "hand" if "stick" in grasped else "push"
+            moved.append(Event(STICK_MOVED, int(steps[0]), obj="stick", by=by))
+            continue
+        if name == brought:
+            by = "caregiver"
+        else:
+            by = "hand" if name in grasped else "stick" if name in caught else "push"
+        moved.append(Event(TOY_MOVED, int(steps[0]), obj=name, by=by))
+    return moved

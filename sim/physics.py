@@ -11,6 +11,7 @@ from dm_control import mujoco as dm_mujoco
 from models import playroom_xml
 from models.layout import TOYS
 from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.kinematics import hand_positions
 
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
 OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw
@@ -164,6 +165,21 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._mj_data.qvel[self.object_dof] = 0.0
         mujoco.mj_kinematics(self._mj_model, self._mj_data)
 
+    def advance(self, nstep: int) -> None:
+        """`nstep` physics steps exactly as dm_control's `step` takes them (its legacy order:
+        mj_step2, then nstep - 1 mj_step, then mj_step1, so that position-dependent fields are
+        current), without its per-call check of MuJoCo's warnings: callers that step many
+        times compare `warning_counts` once, before and after."""
+        m, d = self._mj_model, self._mj_data
+        mujoco.mj_step2(m, d)
+        if nstep > 1:
+            mujoco.mj_step(m, d, nstep - 1)
+        mujoco.mj_step1(m, d)
+
+    def warning_counts(self) -> np.ndarray:
+        """(mjNWARNING,) how often MuJoCo has warned of each kind (a diverging state warns)."""
+        return self._mj_data.warning.number.copy()
+
     def touching_pairs(self) -> np.ndarray:
         """(n, 2) geom ids of the pairs MuJoCo reports in contact now."""
         d = self._mj_data
@@ -176,7 +192,21 @@ class KinematicPhysics(PlayroomPhysics):
     """The study's kinematic world: a step only recomputes positions.
 
     The grasp rules set joint and object positions directly (sim/grasp.py); no dynamics run.
+    The hand is where the study's analytic forward kinematics puts it (sim/kinematics.py): the
+    same numbers as the whole-movement rules of sim/kinematic_movement.py, to the last bit.
+    MuJoCo's own hand site agrees with it within 1e-15 m and is what renders.
     """
 
     def step(self, nstep: int = 1) -> None:
         mujoco.mj_kinematics(self._mj_model, self._mj_data)
+
+    def advance(self, nstep: int) -> None:
+        self.step(nstep)
+
+    def hand_position(self) -> np.ndarray:
+        return hand_positions(self.arm_angles()[:, None], self.config)[0]
+
+    def tracked_positions(self) -> np.ndarray:
+        out = super().tracked_positions()
+        out[0] = self.hand_position()
+        return out

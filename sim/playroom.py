@@ -10,7 +10,6 @@ from dm_control.rl import control
 
 from models.layout import (
     ARM_DIM,
-    MOVED_DISTANCE,
     N_ARTICULATORS,
     N_JOINTS,
     N_STEPS,
@@ -27,6 +26,7 @@ from sim.caregiver import Caregiver, WordAssignment
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.grasp import BACKENDS, make_backend
+from sim.kinematic_movement import arm_movement, brought_path
 from sim.model_edits import ModelEdits
 from sim.physics import CONTROL_SUBSTEPS, KinematicPhysics, PlayroomPhysics
 from sim.task import ARM, VOICE, PlayroomTask
@@ -108,8 +108,11 @@ class Playroom:
         distractor: her word is the sound block s[50:60].
         """
         m = _checked_command(m, ARM_DIM, "arm command")
+        targets = arm_trajectory(m, self.config)  # (3, N_STEPS)
+        if self._closed_form:
+            return self._run_kinematic(ARM, joint_targets=targets)
         actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-        actions[:, :N_JOINTS] = arm_trajectory(m, self.config).T
+        actions[:, :N_JOINTS] = targets.T
         return self._run(ARM, actions)
 
     def act_voice(self, m: np.ndarray) -> Feedback:
@@ -125,7 +128,10 @@ class Playroom:
         actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
         formants = self.vocal_tract.trajectory_formants(articulators)
-        feedback = self._run(VOICE, actions, formants)
+        if self._closed_form:
+            feedback = self._run_kinematic(VOICE, voice_formants=formants)
+        else:
+            feedback = self._run(VOICE, actions, formants)
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
@@ -196,6 +202,47 @@ class Playroom:
         self.caregiver.words = WordAssignment(tuple(names), tuple(distractors))
 
     # The movement -------------------------------------------------------------------------
+    @property
+    def _closed_form(self) -> bool:
+        """The kinematic rules run a whole movement at once unless someone watches each step
+        (a video): the step-by-step path through the dm_control task gives the same result."""
+        return self.grasp == "kinematic" and not self.step_observers
+
+    def _run_kinematic(
+        self,
+        movement: str,
+        joint_targets: np.ndarray | None = None,
+        voice_formants: np.ndarray | None = None,
+    ) -> Feedback:
+        """One movement of the kinematic backend in closed form (sim/kinematic_movement.py);
+        the MuJoCo state is set once, at the end."""
+        p = self.physics
+        positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
+        positions[0] = p.tracked_positions()
+        poses = p.object_poses()
+        sound = np.zeros((N_STEPS, 2))
+        held = None
+        if movement == ARM:
+            outcome = arm_movement(self.config, joint_targets, poses[0], poses[1:, :2])
+            positions[1:], events, held = outcome.positions, outcome.events, outcome.hand_holds
+            poses[0] = outcome.stick_pose
+        else:
+            events = self.caregiver.hear(p, voice_formants)
+            positions[1:] = positions[0]
+            sound[:] = self.task.normalised(voice_formants)
+            toy = self.caregiver.bringing
+            if toy is not None:
+                rate = self.config.caregiver_bring_rate
+                path = brought_path(rate, positions[0, 2 + toy], self.caregiver.target(p))
+                positions[1:, 2 + toy] = path
+        poses[1:, :2] = positions[-1, 2:]
+        brought = self.caregiver.bringing
+        events += ev.movement_events(positions, events, None if brought is None else TOYS[brought])
+        said = self.caregiver.speak(held, self.rng) if movement == ARM else None
+        p.set_object_poses(poses)
+        self.caregiver.stop(p)
+        return self._feedback(movement, positions, sound, events, said)
+
     def _run(
         self, movement: str, actions: np.ndarray, voice_formants: np.ndarray | None = None
     ) -> Feedback:
@@ -207,18 +254,24 @@ class Playroom:
         positions[0] = p.tracked_positions()
         self.task.begin_movement(p, movement, voice_formants)
         events = self.caregiver.hear(p, voice_formants) if movement == VOICE else []
+        warnings = p.warning_counts()
         try:
             for k in range(n):
-                obs = self.env.step(actions[k]).observation
-                positions[k + 1, 0] = obs["hand"]
-                positions[k + 1, 1] = obs["stick_handle"]
-                positions[k + 1, 2:] = obs["toys"]
-                sound[k] = obs["sound"]
+                if self.step_observers:  # through the dm_control environment, observed
+                    obs = self.env.step(actions[k]).observation
+                    positions[k + 1] = (obs["hand"], obs["stick_handle"], *obs["toys"])
+                    sound[k] = obs["sound"]
+                    for observer in self.step_observers:
+                        observer(k + 1, obs)
+                else:  # the same step, reading only what the feedback needs
+                    self.task.before_step(actions[k], p)
+                    p.advance(CONTROL_SUBSTEPS)
+                    self.task.after_step(p)
+                    positions[k + 1] = p.tracked_positions()
+                    sound[k] = self.task.sound
                 events += self.task.step_events
-                for observer in self.step_observers:
-                    observer(k + 1, obs)
-            if not np.isfinite(positions).all():
-                raise control.PhysicsError("non-finite positions")
+            if (p.warning_counts() > warnings).any() or not np.isfinite(positions).all():
+                raise control.PhysicsError("MuJoCo warned of an invalid state")
         except control.PhysicsError:
             # Divergence: put everything back where it was and report it; the room goes on.
             self.task.end_movement(p)
@@ -228,7 +281,7 @@ class Playroom:
             said = None
         else:
             brought = self.caregiver.bringing
-            events += _movement_events(
+            events += ev.movement_events(
                 positions, events, None if brought is None else TOYS[brought]
             )
             said = (
@@ -237,6 +290,18 @@ class Playroom:
                 else None
             )
             self.task.end_movement(p)
+        return self._feedback(movement, positions, sound, events, said)
+
+    def _feedback(
+        self,
+        movement: str,
+        positions: np.ndarray,
+        sound: np.ndarray,
+        events: list[ev.Event],
+        said: tuple[np.ndarray, ev.Event] | None,
+    ) -> Feedback:
+        """The movement's feedback from (N_STEPS + 1, 5, 2) positions (row 0: the start) and
+        (N_STEPS, 2) sound; then the room moves on to the next iteration."""
         s = self._sensory(positions[1:], sound)
         if said is not None:
             s[block_slice("sound")], event = said
@@ -309,30 +374,6 @@ def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     ab = b - a
     t = np.clip(np.dot(point - a, ab) / np.dot(ab, ab), 0.0, 1.0)
     return float(np.linalg.norm(point - (a + t * ab)))
-
-
-def _movement_events(
-    positions: np.ndarray, step_events: list[ev.Event], brought: str | None
-) -> list[ev.Event]:
-    """Which objects moved, when first, and by what, from (51, 5, 2) positions (row 0 = start)."""
-    grasped = {e.obj for e in step_events if e.kind in (ev.TOY_GRASPED, ev.STICK_GRASPED)}
-    caught = {e.obj for e in step_events if e.kind == ev.TOY_CAUGHT}
-    moved: list[ev.Event] = []
-    displacement = np.linalg.norm(positions - positions[0], axis=2)  # (51, 5)
-    for row, name in enumerate(TRACKED_OBJECTS[1:], start=1):
-        steps = np.flatnonzero(displacement[:, row] > MOVED_DISTANCE)
-        if steps.size == 0:
-            continue
-        if name == "stick":
-            by = "hand" if "stick" in grasped else "push"
-            moved.append(ev.Event(ev.STICK_MOVED, int(steps[0]), obj="stick", by=by))
-            continue
-        if name == brought:
-            by = "caregiver"
-        else:
-            by = "hand" if name in grasped else "stick" if name in caught else "push"
-        moved.append(ev.Event(ev.TOY_MOVED, int(steps[0]), obj=name, by=by))
-    return moved
 
 
 def _checked_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:

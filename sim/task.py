@@ -66,7 +66,7 @@ class PlayroomTask(control.Task):
             if self._planned_sound is not None:
                 self.sound = self._planned_sound[self.step_index - 1]
             else:
-                self.sound = self._normalised(self.vocal_tract.formants(action[N_JOINTS:]))
+                self.sound = self.normalised(self.vocal_tract.formants(action[N_JOINTS:]))
         self.caregiver.before_step(physics)
 
     def after_step(self, physics: PlayroomPhysics) -> None:
@@ -83,7 +83,8 @@ class PlayroomTask(control.Task):
         obs["sound"] = self.sound.copy()
         return obs
 
-    def _normalised(self, log2_formants: np.ndarray) -> np.ndarray:
+    def normalised(self, log2_formants: np.ndarray) -> np.ndarray:
+        """(..., 2) log2 Hz formants -> the sound sensor's normalised values."""
         voice = self.vocal_tract.config
         return np.asarray(log2_formants, dtype=float) - (voice.f1_offset, voice.f2_offset)
 
@@ -101,7 +102,7 @@ class PlayroomTask(control.Task):
         reads each step's frame; without it, each step's action is sent through the voice."""
         if movement not in (ARM, VOICE):
             raise ValueError(f"unknown movement {movement!r}: 'arm' or 'voice'")
-        self._planned_sound = None if voice_formants is None else self._normalised(voice_formants)
+        self._planned_sound = None if voice_formants is None else self.normalised(voice_formants)
         self.movement = movement
         self.step_index = 0
         self.sound[:] = 0.0
