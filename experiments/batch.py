@@ -11,6 +11,7 @@ started on PBS or SLURM nodes by dask-jobqueue (README). Each trial is one Dask 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -49,6 +50,7 @@ class BatchSpec:
     iterations: int = 1000
     checkpoint_every: int = 1000
     eval_placements: int = 100
+    stick_return: str = "out_of_reach"
     description: str = field(default="", compare=False)
 
     def trials(self) -> list[tuple[str, TrialSettings]]:
@@ -64,6 +66,7 @@ class BatchSpec:
                         seed=seed,
                         babbling=babbling,
                         checkpoint_every=min(self.checkpoint_every, self.iterations),
+                        stick_return=self.stick_return,
                     )
                     out.append((name, settings))
         return out
@@ -89,7 +92,7 @@ def load_spec(
         raw = json.loads(text)
     except json.JSONDecodeError as exc:
         raise BatchError(f"{source} is not valid JSON ({exc})") from None
-    known = {"grasps", "babbling", "seeds", "iterations", "checkpoint_every", "eval_placements"}
+    known = {f.name for f in dataclasses.fields(BatchSpec)} - {"description"}
     unknown = sorted(set(raw) - known - {"description"})
     if unknown:
         raise BatchError(f"{source}: unknown field(s) {', '.join(unknown)}")
@@ -103,6 +106,7 @@ def load_spec(
             iterations=int(raw.get("iterations", 1000)),
             checkpoint_every=int(raw.get("checkpoint_every", 1000)),
             eval_placements=int(raw.get("eval_placements", 100)),
+            stick_return=str(raw.get("stick_return", "out_of_reach")),
             description=raw.get("description", ""),
         )
         spec.trials()  # validates every trial's settings

@@ -63,6 +63,7 @@ def cmd_run(args: argparse.Namespace) -> None:
             seed=args.seed,
             babbling=args.babbling,
             checkpoint_every=args.checkpoint_every,
+            stick_return=args.stick_return,
         )
         trial = run_trial(
             args.out,
@@ -77,7 +78,7 @@ def cmd_run(args: argparse.Namespace) -> None:
     print(
         f"{args.out}: {trial.iteration} iterations ({args.grasp}, seed {args.seed}); "
         f"tool uses {c['tool_uses']}, words recognised {c['words_recognised']}, "
-        f"diverged {c['diverged']}"
+        f"stick returns {c['stick_returns']}, diverged {c['diverged']}"
     )
 
 
@@ -269,6 +270,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="the trial directory")
     p.add_argument("--babbling", choices=["random", "active"], default="random")
     p.add_argument("--checkpoint-every", type=_positive_int, default=1000, metavar="K")
+    p.add_argument(
+        "--stick-return",
+        choices=["out_of_reach", "never"],
+        default="out_of_reach",
+        help="the experimenter returns a stick beyond reach (default), or never (the study)",
+    )
     p.add_argument("--resume", action="store_true", help="continue the trial in --out")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)

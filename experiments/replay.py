@@ -127,9 +127,9 @@ def render_trial(
                         iteration=it,
                     )
 
-                proposal, _, feedback = agent.play(room, act=filmed)
+                proposal, context, feedback = agent.play(room, act=filmed)
                 logged = {"iteration": it, **logged_rows.loc[it].to_dict()}
-                replayed = log_row(it, proposal, feedback)
+                replayed = log_row(it, proposal, feedback, context)
                 results.append(ReplayedIteration(it, logged, replayed))
             else:
                 agent.play(room)

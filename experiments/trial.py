@@ -48,6 +48,7 @@ from experiments.trial_files import (  # noqa: F401 (the trial's files are read 
 from learner.config import LearnerConfig
 from models.layout import TOYS, block_slice
 from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.experimenter import STICK_RETURNS
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
 
@@ -65,10 +66,15 @@ class TrialSettings:
     seed: int = 0
     babbling: str = "random"
     checkpoint_every: int = 1000
+    stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
 
     def __post_init__(self) -> None:
         if self.grasp not in ("kinematic", "physical"):
             raise TrialError(f"unknown grasp {self.grasp!r}: 'kinematic' or 'physical'")
+        if self.stick_return not in STICK_RETURNS:
+            raise TrialError(
+                f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
+            )
         for name in ("iterations", "checkpoint_every"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
@@ -79,13 +85,14 @@ class TrialSettings:
 
 def full_config(
     settings: TrialSettings,
-    world: WorldConfig = DEFAULT_WORLD,
+    world: WorldConfig | None = None,
     voice: VoiceConfig = DEFAULT_VOICE,
     learner: LearnerConfig | None = None,
 ) -> dict:
     """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
     the trial's room and agent from."""
     learner = learner or LearnerConfig(babbling=settings.babbling)
+    world = world or dataclasses.replace(DEFAULT_WORLD, stick_return=settings.stick_return)
     config = {
         "trial": dataclasses.asdict(settings),
         "world": dataclasses.asdict(world),
@@ -122,7 +129,7 @@ class Trial:
             self.agent, self.room = fresh_trial_parts(self.config)
             self.iteration = 0
             self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
-            self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0}
+            self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
             self.elapsed: float | None = None  # seconds of the last `run_trial`
             self.start_iteration = 0
             if resume:
@@ -283,15 +290,16 @@ class Trial:
         bar.close()
 
     def _iterate(self) -> dict:
-        proposal, _, feedback = self.agent.play(self.room)
+        proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
             sound = feedback.s[block_slice("sound")]
             distances = word_distances(sound, self.room.vocal_tract.config)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
-        row = log_row(self.iteration, proposal, feedback)
+        row = log_row(self.iteration, proposal, feedback, context)
         self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
+        self.counts["stick_returns"] += row["stick_returned"]
         return row
 
     def _word_row(self) -> dict:

@@ -26,7 +26,7 @@ from experiments import storage
 from experiments.lock import LOCK_FILE
 from learner.agent import Agent
 from learner.config import LearnerConfig
-from models.layout import TOYS
+from models.layout import TOYS, context_indices
 from sim import Playroom
 from sim import events as ev
 from sim.config import WorldConfig, config_from_dict
@@ -63,18 +63,22 @@ class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
 
-def log_row(iteration: int, proposal, feedback) -> dict:
-    """One row of the iterations log: what was tried and what happened."""
+def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
+    """One row of the iterations log: what was tried, in what context (10,), and what happened.
+    `stick_distance` is the handle's distance from the arm's base before the movement (m)."""
+    handle = context[list(context_indices("stick"))]
     row = {
         "iteration": iteration,
         "motor_space": proposal.motor_space,
         "model": -1 if proposal.model is None else int(proposal.model),
+        "stick_distance": float(np.hypot(*handle)),
         "stick_grasped": False,
         "stick_moved_by": "",
         **{f"{toy}_moved_by": "" for toy in TOYS},
         "word_recognised": "",
         "caregiver_said": "",
         "diverged": False,
+        "stick_returned": False,
     }
     for e in feedback.events:
         if e.kind == ev.STICK_GRASPED:
@@ -89,6 +93,8 @@ def log_row(iteration: int, proposal, feedback) -> dict:
             row["caregiver_said"] = e.word
         elif e.kind == ev.DIVERGED:
             row["diverged"] = True
+        elif e.kind == ev.STICK_RETURNED:
+            row["stick_returned"] = True
     return row
 
 

@@ -33,6 +33,9 @@ class WorldConfig:
     catch_distance: float = 0.1  # m, stick tip to toy
     # Caregiver bringing a toy (docs/protocol.md §6): fraction of the remaining way per step.
     caregiver_bring_rate: float = 0.01
+    # The experimenter returns a stick beyond the hand's reach to its start pose between
+    # iterations ("out_of_reach"), or never, as in the study (sim/experimenter.py, §11).
+    stick_return: str = "out_of_reach"
 
     @property
     def arm_length(self) -> float:

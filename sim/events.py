@@ -18,6 +18,7 @@ WORD_RECOGNISED = "word_recognised"  # the caregiver recognised the agent's soun
 CAREGIVER_SAID = "caregiver_said"  # the caregiver spoke a word (word, obj = toy it names)
 DIVERGED = "diverged"  # the physics diverged; objects were restored to their start
 FORMANT_FALLBACK = "formant_fallback"  # a frame had no formant; the fallback value was used
+STICK_RETURNED = "stick_returned"  # the experimenter put a stick out of reach back (step 50)
 
 KINDS = (
     STICK_GRASPED,
@@ -29,6 +30,7 @@ KINDS = (
     CAREGIVER_SAID,
     DIVERGED,
     FORMANT_FALLBACK,
+    STICK_RETURNED,
 )
 
 

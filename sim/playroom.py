@@ -25,6 +25,7 @@ from sim import events as ev
 from sim.caregiver import Caregiver, WordAssignment
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory, voice_trajectory
+from sim.experimenter import Experimenter
 from sim.grasp import BACKENDS, make_backend
 from sim.kinematic_movement import arm_movement, brought_path
 from sim.model_edits import ModelEdits
@@ -35,9 +36,6 @@ from sim.vocal.tract import VocalTract
 
 # Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
 RANGE_TOLERANCE = 1e-9
-# Toys placed in the physical backend keep this clearance from each other and the stick (m):
-# two solid toys cannot share a place, and overlapping geoms would be pushed apart violently.
-PLACEMENT_CLEARANCE = 0.01
 
 
 class Playroom:
@@ -78,6 +76,7 @@ class Playroom:
         self.env = control.Environment(
             self.physics, self.task, n_sub_steps=CONTROL_SUBSTEPS, time_limit=float("inf")
         )
+        self.experimenter = Experimenter(config, self.physics, solid=grasp == "physical")
         self.env.reset()
         self.iteration = 0
         # Called after every control step with (step, observation): renderers and recorders
@@ -307,7 +306,7 @@ class Playroom:
             s[block_slice("sound")], event = said
             events.append(event)
         self.iteration += 1
-        self._place_for_iteration()
+        events += self._place_for_iteration()
         return Feedback(movement, s, events, positions[1:], sound)
 
     def _sensory(self, positions: np.ndarray, sound: np.ndarray) -> np.ndarray:
@@ -320,60 +319,21 @@ class Playroom:
         return s
 
     # Placements ---------------------------------------------------------------------------
-    def _place_for_iteration(self) -> None:
-        """The caregiver moves every iteration; the toys every `toy_replace_period`."""
+    def _place_for_iteration(self) -> list[ev.Event]:
+        """Between iterations: the experimenter returns a lost stick (if the config says so)
+        and places the toys every `toy_replace_period`; the caregiver moves every iteration.
+        Returns what the experimenter did."""
+        events = self.experimenter.return_stick_if_lost()
         if self.iteration % self.config.toy_replace_period == 0:
-            self._place_toys()
+            self.experimenter.place_toys(self.rng)
         self.caregiver.place(self.physics, self.rng)
         mujoco.mj_forward(self.physics.model.ptr, self.physics.data.ptr)
-
-    def _place_toys(self) -> None:
-        """Each toy picks one of the 3 rings with equal chance and a uniform angle."""
-        p = self.physics
-        poses = p.object_poses()
-        for i in range(len(TOYS)):
-            while True:
-                position = self._random_ring_position()
-                if self.grasp == "kinematic" or self._clear_of_others(position, poses, i):
-                    break
-            poses[1 + i] = (*position, 0.0)
-        p.set_object_poses(poses)
-
-    def _random_ring_position(self) -> np.ndarray:
-        rings = self.config.toy_rings
-        low, high = rings[self.rng.integers(len(rings))]
-        radius = self.rng.uniform(low, high)
-        angle = self.rng.uniform(0.0, 2.0 * np.pi)
-        return radius * np.array([np.cos(angle), np.sin(angle)])
+        return events
 
     @property
     def min_toy_gap(self) -> float:
-        """Distance (m) between the centres of two toys placed side by side: two toy radii
-        (from the MJCF) and the placement clearance."""
-        p = self.physics
-        return 2 * float(p.model.ptr.geom_size[p.toy_geoms[0], 0]) + PLACEMENT_CLEARANCE
-
-    def _clear_of_others(self, position: np.ndarray, poses: np.ndarray, toy: int) -> bool:
-        """Whether a toy at `position` would keep clear of the toys placed before it and the
-        stick."""
-        p = self.physics
-        m = p.model.ptr
-        toy_radius = m.geom_size[p.toy_geoms[0], 0]
-        # The thickest part of the stick (its tip sphere), measured from the handle-tip line.
-        stick_radius = m.geom_size[p.stick_geoms, 0].max()
-        for j in range(toy):
-            if np.linalg.norm(position - poses[1 + j, :2]) < 2 * toy_radius + PLACEMENT_CLEARANCE:
-                return False
-        handle, tip = p.stick_handle(), p.stick_tip()
-        return _segment_distance(position, handle, tip) >= (
-            toy_radius + stick_radius + PLACEMENT_CLEARANCE
-        )
-
-
-def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-    ab = b - a
-    t = np.clip(np.dot(point - a, ab) / np.dot(ab, ab), 0.0, 1.0)
-    return float(np.linalg.norm(point - (a + t * ab)))
+        """Distance (m) between the centres of two toys placed side by side."""
+        return self.experimenter.min_toy_gap
 
 
 def _checked_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:
