@@ -19,17 +19,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from experiments import storage
+from experiments.curves import curve_rows, tool_numbers
 from experiments.evaluation import COMPETENCE_FILE, EVAL_FILE, VOCAL_FILE
 from experiments.trial import CONFIG_FILE, read_log
 
 TIMING_FILE = "timing.json"
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
-# Developmental curves have about this many points per trial, each a window of iterations.
-CURVE_POINTS = 40
 
 
 class ReportError(Exception):
@@ -48,10 +46,8 @@ class BatchResults:
     - competence: competence.parquet rows (ring, placement, toy, x, y, distance, strategy,
       error, random_error, ...).
     - vocal: vocal.parquet rows (word, is_name, best_distance).
-    - curves: long table (iteration, metric, value) of developmental curves: tool_use (share of
-      arm movements that moved a toy with the stick), stick_grasp (share of arm movements),
-      word_recognised (share of vocal movements), best_distance_names and
-      best_distance_distractors (mean best distance so far of the trial's names/distractors).
+    - curves: long table (iteration, metric, value) of developmental curves
+      (experiments/curves.py).
     - configs: group -> the group's common config (trial.seed removed).
     """
 
@@ -213,64 +209,6 @@ def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[
         )
 
 
-def curve_rows(
-    log: pd.DataFrame, words: pd.DataFrame, iterations: int, names: set[str]
-) -> pd.DataFrame:
-    """A trial's developmental curves (long table: iteration, metric, value) from its logs:
-    rates in windows of iterations (about CURVE_POINTS of them, a multiple of 50 iterations
-    each), best word distances wherever the words log has a row."""
-    window = max(50, round(iterations / CURVE_POINTS / 50) * 50)
-    end = (log["iteration"].to_numpy() // window + 1) * window
-    arm = log["motor_space"] == "arm"
-    voice = log["motor_space"] == "voice"
-    toy_columns = [c for c in log.columns if c.startswith("toy") and c.endswith("_moved_by")]
-    by_stick = (log[toy_columns] == "stick").any(axis=1)
-    frame = pd.DataFrame(
-        {
-            "end": np.minimum(end, iterations),
-            "arm": arm,
-            "voice": voice,
-            "tool_use": by_stick & arm,
-            "stick_grasp": log["stick_grasped"].astype(bool) & arm,
-            "word_recognised": (log["word_recognised"] != "") & voice,
-        }
-    )
-    sums = frame.groupby("end").sum()
-    # A window without arm (or voice) movements has no rate: NaN, not a division warning.
-    with np.errstate(invalid="ignore", divide="ignore"):
-        parts = [
-            pd.DataFrame(
-                {
-                    "iteration": sums.index,
-                    "metric": metric,
-                    "value": (sums[metric] / sums[base].replace(0, np.nan)).to_numpy(),
-                }
-            )
-            for metric, base in (
-                ("tool_use", "arm"),
-                ("stick_grasp", "arm"),
-                ("word_recognised", "voice"),
-            )
-        ]
-    if not words.empty:
-        # A word never approached has distance inf; it would make every mean inf.
-        values = words.drop(columns="iteration").replace(np.inf, np.nan)
-        for metric, chosen in (
-            ("best_distance_names", [w for w in values.columns if w in names]),
-            ("best_distance_distractors", [w for w in values.columns if w not in names]),
-        ):
-            parts.append(
-                pd.DataFrame(
-                    {
-                        "iteration": words["iteration"],
-                        "metric": metric,
-                        "value": values[chosen].mean(axis=1),
-                    }
-                )
-            )
-    return pd.concat(parts, ignore_index=True)
-
-
 def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(iterations log, words log) of a trial; ReportError if unreadable or missing."""
     try:
@@ -320,9 +258,9 @@ def _trial_rows(
     comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
     voc = _read_table(d / VOCAL_FILE).assign(**keys)
     log, words = _read_logs(d)
-    curve = curve_rows(
-        log, words, config["trial"]["iterations"], set(voc.loc[voc["is_name"], "word"])
-    ).assign(**keys)
+    reach = sum(config["world"]["segment_lengths"]) + config["world"]["grasp_distance"]
+    names = set(voc.loc[voc["is_name"], "word"])
+    curve = curve_rows(log, words, config["trial"]["iterations"], names, reach).assign(**keys)
     seconds, timed = _timing(d)
     row = {
         **keys,
@@ -333,6 +271,7 @@ def _trial_rows(
         "n_placements": summary.get("n_placements"),
         **_eval_numbers(d, summary),
         "diverged": int(log["diverged"].sum()),
+        **tool_numbers(log, reach),
         "seconds": seconds,
         "timed_iterations": timed,
     }

@@ -6,8 +6,8 @@ In the study's kinematic world a dropped stick lies where the hand let it go, al
 reach. In the physical world a stick can be pushed, and pushes add up until it lies beyond any
 reach for the rest of the trial, a situation the study never had. With `stick_return =
 "out_of_reach"` (the default) the experimenter puts it back at its start pose at the end of an
-iteration in which its handle lies farther from the arm's base than the arm's length plus the
-grasp distance; with "never" the stick stays where it is, as in the study's text.
+iteration after which the backend's grasp rule can no longer reach its handle (`stick_lost`);
+with "never" the stick stays where it is, as in the study's text.
 """
 
 from __future__ import annotations
@@ -81,9 +81,20 @@ class Experimenter:
 
     # The stick ----------------------------------------------------------------------------
     def stick_lost(self) -> bool:
-        """Whether the stick's handle lies beyond the hand's reach (arm + grasp distance)."""
-        reach = self.config.arm_length + self.config.grasp_distance
-        return float(np.hypot(*self.physics.stick_handle())) > reach
+        """Whether the backend's grasp rule can no longer reach the stick's handle: in the
+        kinematic backend the handle lies beyond the arm's length plus the grasp distance; in
+        the physical one no point of the handle geom lies within the arm's length plus the
+        radii of the hand sphere and of the handle (contact is impossible)."""
+        cfg, p = self.config, self.physics
+        if not self.solid:
+            return float(np.hypot(*p.stick_handle())) > cfg.arm_length + cfg.grasp_distance
+        m, d = p.model.ptr, p.data.ptr
+        handle = p.handle_geom
+        axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z
+        centre, half = d.geom_xpos[handle, :2], m.geom_size[handle, 1]
+        nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
+        contact = m.geom_size[p.hand_geom, 0] + m.geom_size[handle, 0]
+        return nearest > cfg.arm_length + contact
 
     def return_stick_if_lost(self) -> list[ev.Event]:
         """With stick_return 'out_of_reach': a lost stick back at its start pose, if no toy

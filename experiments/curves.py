@@ -1,0 +1,95 @@
+"""What a trial's logs say over time: developmental curves and the stick as a tool.
+
+Curves are rates in windows of iterations (about CURVE_POINTS per trial, a multiple of 50
+iterations each), in a long table (iteration, metric, value):
+- tool_use: share of arm movements in which the stick moved a toy (a toy caught);
+- stick_grasp: share of arm movements in which the hand took the stick;
+- word_recognised: share of vocal movements in which the caregiver recognised a word;
+- stick_in_reach: share of iterations that began with the stick's handle within the hand's
+  reach (arm length plus grasp distance); stick_returned: share of iterations after which the
+  experimenter returned the stick (logs written before these columns existed have neither);
+- best_distance_names, best_distance_distractors: mean best distance so far of the trial's
+  names and distractors, wherever the words log has a row.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+CURVE_POINTS = 40
+# Metric -> the column of movements it is a share of.
+RATES = {
+    "tool_use": "arm",
+    "stick_grasp": "arm",
+    "word_recognised": "voice",
+    "stick_in_reach": "all",
+    "stick_returned": "all",
+}
+
+
+def _events(log: pd.DataFrame, reach: float) -> pd.DataFrame:
+    """Per iteration: arm, voice, all, and each metric of RATES (bool)."""
+    arm = log["motor_space"] == "arm"
+    voice = log["motor_space"] == "voice"
+    toy_columns = [c for c in log.columns if c.startswith("toy") and c.endswith("_moved_by")]
+    frame = pd.DataFrame(
+        {
+            "arm": arm,
+            "voice": voice,
+            "all": True,
+            "tool_use": (log[toy_columns] == "stick").any(axis=1) & arm,
+            "stick_grasp": log["stick_grasped"].astype(bool) & arm,
+            "word_recognised": (log["word_recognised"] != "") & voice,
+        }
+    )
+    if "stick_distance" in log.columns:
+        frame["stick_in_reach"] = log["stick_distance"] <= reach
+        frame["stick_returned"] = log["stick_returned"].astype(bool)
+    return frame
+
+
+def curve_rows(
+    log: pd.DataFrame, words: pd.DataFrame, iterations: int, names: set[str], reach: float
+) -> pd.DataFrame:
+    """A trial's curves (module docstring) from its iterations and words logs; `reach` (m)."""
+    window = max(50, round(iterations / CURVE_POINTS / 50) * 50)
+    frame = _events(log, reach)
+    frame["end"] = np.minimum((log["iteration"].to_numpy() // window + 1) * window, iterations)
+    sums = frame.groupby("end").sum()
+    parts = []
+    # A window without arm (or voice) movements has no rate: NaN, not a division warning.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for metric, base in RATES.items():
+            if metric in sums.columns:
+                value = (sums[metric] / sums[base].replace(0, np.nan)).to_numpy()
+                parts.append(
+                    pd.DataFrame({"iteration": sums.index, "metric": metric, "value": value})
+                )
+    if not words.empty:
+        # A word never approached has distance inf; it would make every mean inf.
+        values = words.drop(columns="iteration").replace(np.inf, np.nan)
+        for metric, chosen in (
+            ("best_distance_names", [w for w in values.columns if w in names]),
+            ("best_distance_distractors", [w for w in values.columns if w not in names]),
+        ):
+            value = values[chosen].mean(axis=1)
+            parts.append(
+                pd.DataFrame({"iteration": words["iteration"], "metric": metric, "value": value})
+            )
+    return pd.concat(parts, ignore_index=True)
+
+
+def tool_numbers(log: pd.DataFrame, reach: float) -> dict[str, float]:
+    """A whole trial's stick numbers: stick grasps and toy catches per 1000 arm movements, the
+    share of iterations that began with the stick within reach, and the experimenter's returns
+    (NaN where the log predates the column)."""
+    frame = _events(log, reach)
+    arms = max(1, int(frame["arm"].sum()))
+    has_stick = "stick_in_reach" in frame.columns
+    return {
+        "stick_grasps_per_1000_arm": 1000 * frame["stick_grasp"].sum() / arms,
+        "toy_catches_per_1000_arm": 1000 * frame["tool_use"].sum() / arms,
+        "stick_in_reach": float(frame["stick_in_reach"].mean()) if has_stick else np.nan,
+        "stick_returns": float(frame["stick_returned"].sum()) if has_stick else np.nan,
+    }
