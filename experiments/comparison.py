@@ -42,8 +42,11 @@ from experiments.statistics import (
     summarise,
     welch,
 )
+from experiments.stick import grasp_rates
 
 COMPARISON_FILE = "comparison.html"
+# Random arm commands behind the comparison's stick-grasp rates of the two backends.
+GRASP_RATE_COMMANDS = 1000
 
 
 def _sides(dir_a: Path, dir_b: Path) -> tuple[BatchResults, BatchResults]:
@@ -124,6 +127,48 @@ def _strategy_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list
     return rows
 
 
+# Per-trial stick numbers (experiments/curves.py): (column, statistic, how to show it).
+STICK_NUMBERS = (
+    ("stick_in_reach", "Iterations that began with the stick within reach", pct),
+    ("stick_grasps_per_1000_arm", "Stick grasps per 1000 arm movements", num),
+    ("toy_catches_per_1000_arm", "Toys caught with the stick per 1000 arm movements", num),
+    ("stick_returns", "Stick returns by the experimenter per trial", num),
+)
+
+
+def _stick_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list[list[str]]:
+    """The stick as a tool: per-trial numbers (Welch), the tool tests split into stick held
+    and stick only pushed (χ²), and how often random commands grasp it from its start."""
+    rows = []
+    for column, name, shown in STICK_NUMBERS:
+        values = [s.trials[column].to_numpy(dtype=float) for s in (a, b)]
+        if any(np.isnan(v).all() for v in values):
+            continue  # logs written before the column existed
+        texts = [f"{shown(np.nanmean(v))} (n={len(v)})" for v in values]
+        rows.append([name, *texts, "Welch t (per-trial values)", p_value(welch(*values)[1])])
+    tools = [s.competence[s.competence["strategy"] == "tool"] for s in (a, b)]
+    if all("stick_grasped" in t.columns for t in tools):
+        held = [int(t["stick_grasped"].sum()) for t in tools]
+        pushed = [len(t) - h for t, h in zip(tools, held, strict=True)]
+        texts = [f"{h} / {p}" for h, p in zip(held, pushed, strict=True)]
+        p = chi_square(np.array([held, pushed]).T)[1]
+        rows.append(
+            ["Tool tests: stick held / only pushed", *texts, "χ² (pooled tests)", p_value(p)]
+        )
+    return rows
+
+
+def _grasp_rate_row(a: BatchResults, b: BatchResults, n_commands: int) -> list[list[str]]:
+    """The share of the same random arm commands that grasp the stick from its start pose in
+    each backend (experiments/stick.py), when the two sides are the two backends."""
+    grasps = [s.trials["grasp"].iloc[0] for s in (a, b)]
+    if sorted(grasps) != ["kinematic", "physical"]:
+        return []
+    rates = grasp_rates(n_commands)
+    texts = [f"{pct(rates[g], 1)} of {n_commands}" for g in grasps]
+    return [["Random arm commands that grasp the stick at its start", *texts, "same commands", ""]]
+
+
 def _vocal_rows(a: BatchResults, b: BatchResults, threshold: float) -> list[list[str]]:
     """Share of words within the threshold (Fisher exact) and median best distances
     (Mann-Whitney U), on the words of every trial pooled."""
@@ -178,23 +223,34 @@ def _cost_rows(a: BatchResults, b: BatchResults) -> list[list[str]]:
     ]
 
 
-def difference_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list[list[str]]:
+def difference_rows(
+    a: BatchResults,
+    b: BatchResults,
+    geometry: Geometry,
+    grasp_rate_commands: int = GRASP_RATE_COMMANDS,
+) -> list[list[str]]:
     """[statistic, A, B, test, p] rows: is the difference between the two groups real?
     `a`, `b`: one group each."""
     return [
         *_competence_rows(a, b),
         *_strategy_rows(a, b, geometry),
         *_vocal_rows(a, b, geometry.threshold),
+        *_stick_rows(a, b, geometry),
+        *_grasp_rate_row(a, b, grasp_rate_commands),
         *_cost_rows(a, b),
     ]
 
 
 def write_comparison(
-    dir_a: str | os.PathLike, dir_b: str | os.PathLike, out_dir: str | os.PathLike
+    dir_a: str | os.PathLike,
+    dir_b: str | os.PathLike,
+    out_dir: str | os.PathLike,
+    grasp_rate_commands: int = GRASP_RATE_COMMANDS,
 ) -> Path:
     """Two batches (e.g. kinematic and physical grasping) side by side: every figure with one
     panel per batch, the paper table with both, tests of their differences and the cost per
-    iteration of each. `dir_a` may equal `dir_b` for one batch of exactly two groups. Writes
+    iteration of each, and the stick's numbers (with `grasp_rate_commands` random commands
+    played in both backends). `dir_a` may equal `dir_b` for one batch of exactly two groups. Writes
     `comparison.html` and `comparison-*.png` into out_dir; returns the page's path."""
     dir_a, dir_b = Path(dir_a), Path(dir_b)
     a, b = _sides(dir_a, dir_b)
@@ -219,7 +275,7 @@ def write_comparison(
         configs=merged.configs,
         tests=Table(
             ["statistic", g[0], g[1], "test of the difference", "p"],
-            difference_rows(a, b, geometry),
+            difference_rows(a, b, geometry, grasp_rate_commands),
         ),
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),
         paper=published,

@@ -30,6 +30,7 @@ from experiments.trial import TrialLocked, load_trial
 from learner.agent import Agent
 from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
+from sim import events as ev
 from sim.vocal.config import DEFAULT_VOICE
 
 EVAL_FILE = "eval.json"
@@ -128,6 +129,8 @@ def competence_table(
                         "arm_nn_distance": d_arm,
                         "voice_nn_distance": d_voice,
                         "strategy": strategy_of(space, bool(stick_moved)),
+                        # A tool test either held the stick or only pushed it.
+                        "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
                         "untrained": untrained,
                         "error": error,
                         "random_error": random_error,

@@ -201,6 +201,32 @@ def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshol
             np.inf,
         ),
     )
+    _band_panels(panels, bands, groups, bootstrap)
+    axes[2].axhline(threshold, color="k", lw=1, ls=":", label=f"threshold {threshold}")
+    axes[0].set_title("Tool use")
+    axes[1].set_title("Words the caregiver recognised")
+    axes[2].set_title("Best imitation so far")
+    for ax in axes:
+        handles, labels = ax.get_legend_handles_labels()
+        if handles:
+            ax.legend(fontsize=8)
+    axes[0].text(
+        bootstrap / 2,
+        0.97,
+        "random\nbootstrap",
+        transform=axes[0].get_xaxis_transform(),
+        ha="center",
+        va="top",
+        fontsize=8,
+        color="0.4",
+    )
+    fig.suptitle("Development over iterations (mean over trials, 95% interval shaded)")
+    return fig
+
+
+def _band_panels(panels: tuple, bands: pd.DataFrame, groups: list[str], bootstrap: int) -> None:
+    """Draw curves with their intervals: panels of (axis, [(metric, line style)], y label,
+    scale, largest possible value), the random bootstrap shaded grey."""
     for ax, metrics, ylabel, scale, top in panels:
         ax.axvspan(0, bootstrap, color="0.9", zorder=0)
         for group in groups:
@@ -227,25 +253,22 @@ def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshol
         ax.set_ylabel(ylabel)
         ax.set_xlim(left=0)
         ax.grid(alpha=0.3)
-    axes[2].axhline(threshold, color="k", lw=1, ls=":", label=f"threshold {threshold}")
-    axes[0].set_title("Tool use")
-    axes[1].set_title("Words the caregiver recognised")
-    axes[2].set_title("Best imitation so far")
-    for ax in axes:
-        handles, labels = ax.get_legend_handles_labels()
-        if handles:
-            ax.legend(fontsize=8)
-    axes[0].text(
-        bootstrap / 2,
-        0.97,
-        "random\nbootstrap",
-        transform=axes[0].get_xaxis_transform(),
-        ha="center",
-        va="top",
-        fontsize=8,
-        color="0.4",
+
+
+def stick_in_play(bands: pd.DataFrame, groups: list[str], bootstrap: int) -> Figure:
+    """The stick as a tool over time: within reach, grasped, catching toys."""
+    fig, axes = _panels(3, width=5.0, height=4.2)
+    panels = (
+        (axes[0], [("stick_in_reach", "-")], "stick within reach (% of iterations)", 100, 1),
+        (axes[1], [("stick_grasp", "-")], "stick grasps per 1000 arm movements", 1000, 1),
+        (axes[2], [("tool_use", "-")], "toys caught per 1000 arm movements", 1000, 1),
     )
-    fig.suptitle("Development over iterations (mean over trials, 95% interval shaded)")
+    _band_panels(panels, bands, groups, bootstrap)
+    for ax, title in zip(axes, ("Stick within reach", "Stick grasped", "Toy caught"), strict=True):
+        ax.set_title(title)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8)
+    fig.suptitle("The stick in play (mean over trials, 95% interval shaded)")
     return fig
 
 
@@ -333,6 +356,14 @@ def report_figures(
             "recognised as a word, and mean best distance so far to the trial's toy names "
             "(solid) and distractors (dashed). Grey: the random bootstrap.",
             development(curve_bands(results.curves), g, geometry.bootstrap, geometry.threshold),
+        ),
+        (
+            "stick.png",
+            "The stick in play",
+            "Per window of iterations, mean over trials with a 95% interval: share of "
+            "iterations that began with the stick within the hand's reach, stick grasps and "
+            "toys caught with the stick per 1000 arm movements.",
+            stick_in_play(curve_bands(results.curves), g, geometry.bootstrap),
         ),
         (
             "competence-per-trial.png",

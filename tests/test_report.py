@@ -19,6 +19,7 @@ import pandas as pd
 import pytest
 
 from experiments import figures, paper
+from experiments.curves import curve_rows, tool_numbers
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
 from experiments.report import (
     COMPARISON_FILE,
@@ -113,13 +114,23 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     for trial in batch_b.iterdir():  # one side recorded its cost, the other did not
         (trial / "timing.json").write_text(json.dumps({"seconds": 1.5, "iterations": 300}))
     out = tmp_path / "compare"
-    page = write_comparison(batches["kinematic"], batch_b, out)
+    page = write_comparison(batches["kinematic"], batch_b, out, grasp_rate_commands=20)
     assert page == out / COMPARISON_FILE
     _embedded(page, out, "comparison-*.png")
     text = page.read_text()
     assert "kinematic" in text and "physical" in text
     assert "Welch t" in text and "Mann-Whitney U" in text and "χ²" in text
     assert "not recorded" in text and "5.00 ms / iteration" in text
+    # The stick as a tool, per backend: in reach, grasps, catches, returns, held or pushed.
+    for statistic in (
+        "Iterations that began with the stick within reach",
+        "Stick grasps per 1000 arm movements",
+        "Stick returns by the experimenter per trial",
+        "Tool tests: stick held / only pushed",
+        "Random arm commands that grasp the stick at its start",
+    ):
+        assert statistic in text, statistic
+    assert (out / "comparison-stick.png").exists()
 
 
 # Statistics on hand-made tables ----------------------------------------------------------------
@@ -332,3 +343,26 @@ def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
     assert "<script>" not in text and "<b>batch" not in text
     assert "this batch: &lt;script&gt;alert(1)&lt;/script&gt;" in text
     assert "&lt;b&gt;batch" in text
+
+
+def test_stick_numbers_of_a_hand_made_log():
+    log = pd.DataFrame(
+        {
+            "iteration": range(4),
+            "motor_space": ["arm", "arm", "voice", "arm"],
+            "stick_grasped": [True, False, False, True],
+            "toy1_moved_by": ["stick", "", "", "hand"],
+            "toy2_moved_by": "",
+            "toy3_moved_by": "",
+            "word_recognised": "",
+            "stick_distance": [0.3, 0.7, 0.7, 0.2],
+            "stick_returned": [False, True, False, False],
+        }
+    )
+    numbers = tool_numbers(log, reach=0.6)
+    assert numbers["stick_grasps_per_1000_arm"] == pytest.approx(2000 / 3)
+    assert numbers["toy_catches_per_1000_arm"] == pytest.approx(1000 / 3)
+    assert numbers["stick_in_reach"] == 0.5 and numbers["stick_returns"] == 1
+    curves = curve_rows(log, pd.DataFrame(), iterations=4, names=set(), reach=0.6)
+    in_reach = curves[curves["metric"] == "stick_in_reach"]["value"]
+    assert list(in_reach) == [0.5]
