@@ -51,6 +51,7 @@ class BatchSpec:
     checkpoint_every: int = 1000
     eval_placements: int = 100
     stick_return: str = "out_of_reach"
+    preset: str = "study"
     description: str = field(default="", compare=False)
 
     def trials(self) -> list[tuple[str, TrialSettings]]:
@@ -67,6 +68,7 @@ class BatchSpec:
                         babbling=babbling,
                         checkpoint_every=min(self.checkpoint_every, self.iterations),
                         stick_return=self.stick_return,
+                        preset=self.preset,
                     )
                     out.append((name, settings))
         return out
@@ -107,6 +109,7 @@ def load_spec(
             checkpoint_every=int(raw.get("checkpoint_every", 1000)),
             eval_placements=int(raw.get("eval_placements", 100)),
             stick_return=str(raw.get("stick_return", "out_of_reach")),
+            preset=str(raw.get("preset", "study")),
             description=raw.get("description", ""),
         )
         spec.trials()  # validates every trial's settings

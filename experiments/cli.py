@@ -64,6 +64,7 @@ def cmd_run(args: argparse.Namespace) -> None:
             babbling=args.babbling,
             checkpoint_every=args.checkpoint_every,
             stick_return=args.stick_return,
+            preset=args.preset,
         )
         trial = run_trial(
             args.out,
@@ -275,6 +276,13 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["out_of_reach", "never"],
         default="out_of_reach",
         help="the experimenter returns a stick beyond reach (default), or never (the study)",
+    )
+    p.add_argument(
+        "--preset",
+        choices=["study", "project"],
+        default="study",
+        help="world and learner as the study's code behaved (default), or the project's "
+        "earlier choices (docs/protocol.md §11)",
     )
     p.add_argument("--resume", action="store_true", help="continue the trial in --out")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

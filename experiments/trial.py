@@ -45,9 +45,9 @@ from experiments.trial_files import (  # noqa: F401 (the trial's files are read 
     read_log,
     restore_checkpoint,
 )
-from learner.config import LearnerConfig
+from learner.config import LearnerConfig, learner_preset
 from models.layout import TOYS, block_slice
-from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.config import PRESETS, WorldConfig, world_preset
 from sim.experimenter import STICK_RETURNS
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
@@ -67,10 +67,15 @@ class TrialSettings:
     babbling: str = "random"
     checkpoint_every: int = 1000
     stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
+    # "study": the world and learner as the study's code behaved; "project": this project's
+    # earlier choices (sim.config.world_preset, learner.config.learner_preset).
+    preset: str = "study"
 
     def __post_init__(self) -> None:
         if self.grasp not in ("kinematic", "physical"):
             raise TrialError(f"unknown grasp {self.grasp!r}: 'kinematic' or 'physical'")
+        if self.preset not in PRESETS:
+            raise TrialError(f"unknown preset {self.preset!r}: one of {', '.join(PRESETS)}")
         if self.stick_return not in STICK_RETURNS:
             raise TrialError(
                 f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
@@ -91,8 +96,8 @@ def full_config(
 ) -> dict:
     """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
     the trial's room and agent from."""
-    learner = learner or LearnerConfig(babbling=settings.babbling)
-    world = world or dataclasses.replace(DEFAULT_WORLD, stick_return=settings.stick_return)
+    learner = learner or learner_preset(settings.preset, babbling=settings.babbling)
+    world = world or world_preset(settings.preset, stick_return=settings.stick_return)
     config = {
         "trial": dataclasses.asdict(settings),
         "world": dataclasses.asdict(world),

@@ -79,12 +79,19 @@ class Agent:
         self._block_of = [SENSORY_BLOCKS.index(spec.sensory_block) for spec in self.specs]
         self.interest = InterestModel(len(self.specs), self.config)
         cfg = self.config
-        order = np.repeat(np.array([0, 1], dtype=np.int8), [cfg.bootstrap_arm, cfg.bootstrap_voice])
-        self._bootstrap_order = self.rng.permutation(order)
+        if cfg.bootstrap == "coin_not_learned":  # each command arm or voice, a coin's toss
+            self._bootstrap_order = (self.rng.random(cfg.n_bootstrap) < 0.5).astype(np.int8)
+        else:
+            order = [cfg.bootstrap_arm, cfg.bootstrap_voice]
+            self._bootstrap_order = self.rng.permutation(
+                np.repeat(np.array([0, 1], np.int8), order)
+            )
         self.t = 0  # iterations learnt
         # Ring buffer of the sounds heard after the last `imitation_memory` arm movements.
         self._heard = np.zeros((cfg.imitation_memory, BLOCK_DIM))
         self._n_heard = 0
+        # Every distinct caregiver sound heard so far (the "all_heard" imitation pool).
+        self._distinct_heard = np.zeros((0, BLOCK_DIM))
         self._sound_slice = block_slice("sound")
         self._pending: Proposal | None = None
 
@@ -110,7 +117,7 @@ class Agent:
                 goal, kind = self._imitation_goal(), "imitation"
             else:
                 goal = self.rng.uniform(cfg.goal_low, cfg.goal_high, model.sensory_dim)
-            if len(model) == 0:
+            if model.outcomes < cfg.outcomes_to_infer:
                 m = self.rng.uniform(cfg.motor_low, cfg.motor_high, model.motor_dim)
                 inferred = False
             else:
@@ -145,8 +152,15 @@ class Agent:
             raise ValueError("learn() takes the proposal returned by the last propose()")
         context = self._check_context(context)
         s = _checked_vector(s, SENSORY_DIM, "feedback s")
+        cfg = self.config
+        if proposal.kind == "bootstrap" and cfg.bootstrap == "coin_not_learned":
+            self.t += 1  # the study's published runs learned nothing from the bootstrap
+            self._pending = None
+            return
+        if cfg.clip_sensory:
+            s = np.clip(s, -1.0, 1.0)
         m = proposal.m
-        changed = changed_blocks(context, s, self.config.change_tolerance)
+        changed = changed_blocks(context, s, cfg.change_tolerance, cfg.storing_rule)
         for k in self._by_space[proposal.motor_space]:
             if changed[self._block_of[k]]:
                 self.models[k].store(m, context, s)
@@ -155,9 +169,8 @@ class Agent:
             self.interest.update(proposal.model, proposal.goal, reached)
         if proposal.motor_space == "arm":
             sound = s[self._sound_slice]
-            if np.any(np.abs(sound) > self.config.change_tolerance):  # she spoke
-                self._heard[self._n_heard % len(self._heard)] = sound
-                self._n_heard += 1
+            if np.any(np.abs(sound) > cfg.change_tolerance):  # she spoke
+                self._hear(sound)
         self.t += 1
         self._pending = None
 
@@ -210,6 +223,7 @@ class Agent:
             "bootstrap_order": self._bootstrap_order.copy(),
             "heard": self._heard.copy(),
             "n_heard": np.array(self._n_heard, dtype=np.int64),
+            "distinct_heard": self._distinct_heard.copy(),
         }
         for key, value in self.interest.state_dict().items():
             state[f"interest.{key}"] = value
@@ -246,11 +260,24 @@ class Agent:
         self._bootstrap_order = order.copy()
         self._heard = heard.copy()
         self._n_heard = int(state["n_heard"])
+        distinct = np.asarray(state.get("distinct_heard", np.zeros((0, BLOCK_DIM))), float)
+        self._distinct_heard = distinct.reshape(-1, BLOCK_DIM).copy()
         self._pending = None
 
     # ------------------------------------------------------------------ helpers
 
+    def _hear(self, sound: np.ndarray) -> None:
+        """Remember a caregiver sound: in the ring buffer of recent sounds, or, with the
+        "all_heard" pool, among the distinct sounds heard so far (never forgotten)."""
+        if self.config.imitation_pool == "all_heard":
+            if not (self._distinct_heard == sound).all(axis=1).any():
+                self._distinct_heard = np.vstack([self._distinct_heard, sound])
+        self._heard[self._n_heard % len(self._heard)] = sound
+        self._n_heard += 1
+
     def _imitation_goal(self) -> np.ndarray:
+        if self.config.imitation_pool == "all_heard":  # in the order first heard
+            return self._distinct_heard[self.rng.integers(len(self._distinct_heard))].copy()
         sounds = self.heard_sounds
         if self.config.imitation_draw == "distinct":
             sounds = np.unique(sounds, axis=0)  # sorted: the draw does not depend on order

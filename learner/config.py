@@ -18,6 +18,9 @@ from models import layout
 
 BABBLING_MODES = ("random", "active")
 IMITATION_DRAWS = ("distinct", "heard")
+IMITATION_POOLS = ("recent", "all_heard")
+BOOTSTRAPS = ("shuffled_learned", "coin_not_learned")
+STORING_RULES = ("moved_from_start", "varies_about_mean")
 
 
 @dataclass(frozen=True)
@@ -51,9 +54,27 @@ class LearnerConfig:
     # than this (metres for positions, normalised log2-Hz for sounds). It absorbs the jitter of
     # resting objects in the physical backend; real movements are centimetres.
     change_tolerance: float = layout.MOVED_DISTANCE
+    # How the study's code behaved where the paper is silent or says otherwise (docs/protocol.md
+    # §11 D3-D8); the "study" preset (`learner_preset`) sets each to the code's behaviour.
+    # "moved_from_start": a block changed when a sample left the object's start (or, for the
+    # sound, silence); "varies_about_mean": when its 5 samples vary about their mean,
+    # |x - mean x| + |y - mean y| > change_tolerance (the study's code).
+    storing_rule: str = "moved_from_start"
+    # The whole feedback clipped to [-1, 1] before learning, as the study's code did.
+    clip_sensory: bool = False
+    # "recent": imitation draws from the last `imitation_memory` sounds heard; "all_heard":
+    # from every distinct caregiver word heard so far (the study's code).
+    imitation_pool: str = "recent"
+    # "shuffled_learned": exactly bootstrap_arm + bootstrap_voice random commands in a shuffled
+    # order, learned from (the paper); "coin_not_learned": as many commands, each arm or voice
+    # with probability 1/2, not learned from (the study's published runs).
+    bootstrap: str = "shuffled_learned"
+    # A model proposes random commands until it has stored this many different outcomes
+    # (the study's code: 2).
+    outcomes_to_infer: int = 1
 
     def __post_init__(self) -> None:
-        for name in ("progress_window", "imitation_memory"):
+        for name in ("progress_window", "imitation_memory", "outcomes_to_infer"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value <= 0:
                 raise ValueError(f"LearnerConfig.{name} must be a positive integer, got {value!r}")
@@ -82,6 +103,15 @@ class LearnerConfig:
             raise ValueError(
                 f"LearnerConfig.babbling must be one of {BABBLING_MODES}, got {self.babbling!r}"
             )
+        for name, choices in (
+            ("imitation_pool", IMITATION_POOLS),
+            ("bootstrap", BOOTSTRAPS),
+            ("storing_rule", STORING_RULES),
+        ):
+            if getattr(self, name) not in choices:
+                raise ValueError(
+                    f"LearnerConfig.{name} must be one of {choices}, got {getattr(self, name)!r}"
+                )
         if self.imitation_draw not in IMITATION_DRAWS:
             raise ValueError(
                 f"LearnerConfig.imitation_draw must be one of {IMITATION_DRAWS}, "
@@ -113,3 +143,22 @@ def _finite(value: Any) -> bool:
 
 
 DEFAULT_LEARNER = LearnerConfig()
+PRESETS = ("study", "project")
+
+
+def learner_preset(preset: str, **overrides: Any) -> LearnerConfig:
+    """The learner of a preset: "study" behaves as the study's code did (docs/protocol.md
+    §11 D3-D8: sigma 0.1, the published bootstrap, two outcomes before inferring, the storing
+    rule on the samples' spread, clipped feedback, every heard word imitated); "project" keeps
+    this project's earlier choices. `overrides` change single fields."""
+    if preset not in PRESETS:
+        raise ValueError(f"unknown preset {preset!r}: one of {PRESETS}")
+    study = {
+        "exploration_sigma": 0.1,
+        "bootstrap": "coin_not_learned",
+        "outcomes_to_infer": 2,
+        "storing_rule": "varies_about_mean",
+        "clip_sensory": True,
+        "imitation_pool": "all_heard",
+    }
+    return LearnerConfig(**{**(study if preset == "study" else {}), **overrides})

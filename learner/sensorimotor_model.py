@@ -66,9 +66,17 @@ def _reference_indices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
 _CTX_DST, _CTX_SRC, _S_DST, _S_SRC = _reference_indices()
 
 
-def changed_blocks(context: np.ndarray, s: np.ndarray, tolerance: float) -> np.ndarray:
-    """The storing rule (module docstring) for every block of SENSORY_BLOCKS at once: (6,)
-    bool, from a context (10,) and feedback (60,)."""
+def changed_blocks(
+    context: np.ndarray, s: np.ndarray, tolerance: float, rule: str = "moved_from_start"
+) -> np.ndarray:
+    """The storing rule for every block of SENSORY_BLOCKS at once: (6,) bool, from a context
+    (10,) and feedback (60,). "moved_from_start": the module docstring's rule;
+    "varies_about_mean": the study's, |x - mean x| + |y - mean y| > tolerance over the block's
+    5 x and 5 y samples (F1 and F2 for the sound)."""
+    if rule == "varies_about_mean":
+        xy = s.reshape(len(SENSORY_BLOCKS), 2, N_SAMPLES)
+        spread = np.linalg.norm(xy - xy.mean(axis=2, keepdims=True), axis=2).sum(axis=1)
+        return spread > tolerance
     reference = np.zeros(SENSORY_DIM)
     reference[_CTX_DST] = context[_CTX_SRC]
     reference[_S_DST] = s[_S_SRC]
@@ -85,7 +93,9 @@ class SensorimotorModel:
         self.sensory_slice = spec.sensory_slice
         self.sensory_dim = BLOCK_DIM
         self._tolerance = config.change_tolerance
+        self._rule = config.storing_rule
         self._block = SENSORY_BLOCKS.index(spec.sensory_block)
+        self.outcomes = 0  # different sensory outcomes stored, counted up to 2
         c_dim = len(self.context_dims)
         self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
         self._n = 0
@@ -114,7 +124,8 @@ class SensorimotorModel:
 
     def sensory_changed(self, context: np.ndarray, s: np.ndarray) -> bool:
         """The storing rule (module docstring), for a full context (10,) and feedback (60,)."""
-        return bool(changed_blocks(context, s, self._tolerance)[self._block])
+        changed = changed_blocks(context, s, self._tolerance, self._rule)
+        return bool(changed[self._block])
 
     def update(self, m: np.ndarray, context: np.ndarray, s: np.ndarray) -> bool:
         """Store (m, c_i, s_i) if the sensory block changed; return whether it was stored.
@@ -129,6 +140,7 @@ class SensorimotorModel:
     def store(self, m: np.ndarray, context: np.ndarray, s: np.ndarray) -> None:
         """Store (m, c_i, s_i) without the storing rule, from checked, finite vectors."""
         c_i = context[self.context_dims]
+        self._count_outcome(s[self.sensory_slice])
         self._inverse.append(np.concatenate((c_i, s[self.sensory_slice])), checked=True)
         self._append_motor(m[None, :])
         if self._forward is not None:
@@ -156,9 +168,25 @@ class SensorimotorModel:
         if not np.isfinite(motor).all():
             raise ValueError("motor rows have a NaN or infinite value")
         self._inverse.extend(np.hstack((context, sensory)))
+        self._recount_outcomes()
         self._append_motor(motor)
         if self._forward is not None:
             self._forward.extend(np.hstack((motor, context)))
+
+    def _count_outcome(self, block: np.ndarray) -> None:
+        """Count a newly stored sensory block towards `outcomes` (1, or 2 once one differs
+        from the first stored)."""
+        if self.outcomes == 0:
+            self.outcomes = 1
+        elif self.outcomes == 1 and not np.array_equal(block, self.sensory[0]):
+            self.outcomes = 2
+
+    def _recount_outcomes(self) -> None:
+        sensory = self.sensory
+        if len(sensory) == 0:
+            self.outcomes = 0
+        else:
+            self.outcomes = 2 if (sensory != sensory[0]).any() else 1
 
     def inverse(self, context: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, float]:
         """(motor command (motor_dim,) of the stored (c_i, s_i) nearest to (c_i, goal), distance).
@@ -202,6 +230,7 @@ class SensorimotorModel:
                 f"keys does not fit motor dimension {self.motor_dim}"
             )
         self._inverse.load_state_dict({"rows": key})
+        self._recount_outcomes()
         self._motor = np.empty((_INITIAL_CAPACITY, self.motor_dim))
         self._n = 0
         self._append_motor(motor)

@@ -19,7 +19,8 @@ class WorldConfig:
     # Arm (docs/protocol.md §1).
     segment_lengths: tuple[float, float, float] = (0.25, 0.15, 0.10)  # m
     arm_rest_offset: float = math.pi / 2  # rad: at rest the arm points along +y
-    # DMPs (docs/protocol.md §2).
+    # DMPs (docs/protocol.md §2): "study" (the study's own DMP) or "project" (pydmps style).
+    dmp: str = "project"
     dmp_weight_scale: float = 300.0  # scales the weights in [-1, 1]
     # Objects (docs/protocol.md §1).
     stick_length: float = 0.25  # m
@@ -31,6 +32,10 @@ class WorldConfig:
     # Kinematic grasp rules (docs/protocol.md §5).
     grasp_distance: float = 0.1  # m, hand to handle or toy
     catch_distance: float = 0.1  # m, stick tip to toy
+    # "study": the stick's tip catches a toy whether or not the stick is held (arm movements),
+    # and the resting hand takes a stick lying within reach during vocal movements; "held_stick":
+    # only a stick in the hand catches, and nothing is grasped during vocal movements.
+    catch_rule: str = "held_stick"
     # Caregiver bringing a toy (docs/protocol.md §6): fraction of the remaining way per step.
     caregiver_bring_rate: float = 0.01
     # The experimenter returns a stick beyond the hand's reach to its start pose between
@@ -44,6 +49,20 @@ class WorldConfig:
 
 
 DEFAULT_WORLD = WorldConfig()
+PRESETS = ("study", "project")
+
+
+def world_preset(preset: str, **overrides: Any) -> WorldConfig:
+    """The world of a preset: "study" moves and grasps as the study's code did (its DMP; its
+    catch rule, which only the kinematic backend applies: docs/protocol.md §11 D1, D10);
+    "project" keeps this project's earlier choices. `overrides` change single fields."""
+    if preset not in PRESETS:
+        raise ValueError(f"unknown preset {preset!r}: one of {PRESETS}")
+    study = {"dmp": "study", "catch_rule": "study"}
+    return dataclasses.replace(
+        DEFAULT_WORLD, **{**(study if preset == "study" else {}), **overrides}
+    )
+
 
 Config = TypeVar("Config")
 

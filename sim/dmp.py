@@ -1,8 +1,15 @@
-"""Discrete Dynamical Movement Primitives (Ijspeert et al. 2013), vectorised over dimensions.
+"""Discrete Dynamical Movement Primitives, vectorised over dimensions (docs/protocol.md §2).
 
 A DMP turns a start, an end and a few basis-function weights per dimension into a smooth
 n-step trajectory. The forcing term is not multiplied by (end - start), so a movement that
 starts and ends at the same place can still have a shape (the study's arm starts at rest, 0).
+Two kinds (`WorldConfig.dmp`):
+- "study": the study's own DMP (its `dmp/` package): phase x_t = 0.98^t, centres exp(-d) for d
+  evenly from 0.9 to 0, widths 8 n^2 / c^1.5, forcing x sum(psi w) / sum(psi), and a velocity
+  that is never integrated, so each step is y <- y + 0.0625 (g - y) + 0.0004 f;
+- "project": a pydmps-style spring-damper (Ijspeert et al. 2013) with integrated velocity.
+Both are linear in (start, end, weights), so each is integrated once per unit input and every
+rollout is one matrix product.
 """
 
 from __future__ import annotations
@@ -55,19 +62,55 @@ def _integrate(start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps:
     return out[INTEGRATION_SUBSTEPS - 1 :: INTEGRATION_SUBSTEPS].T
 
 
+# The study's DMP (its dmp/cs.py, dmp_discrete.py): dt = 1/50, gains alpha_y = 25,
+# beta_y = alpha_y / 4, the phase decaying by (1 - dt) per step.
+STUDY_DT = 1.0 / 50.0
+STUDY_CENTRE_SPAN = 0.9  # centres exp(-d) for d evenly from 0.9 to 0
+STUDY_WIDTH_GAIN = 8.0  # widths 8 n^2 / c^1.5
+
+
+def _integrate_study(
+    start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int
+) -> np.ndarray:
+    """The study's first-order DMP: (d,), (d,), (d, n_bfs) -> (d, n_steps), y after each step."""
+    n_bfs = weights.shape[1]
+    phase = (1.0 - STUDY_DT) ** np.arange(n_steps)
+    centres = np.exp(-np.linspace(STUDY_CENTRE_SPAN, 0.0, n_bfs))
+    widths = STUDY_WIDTH_GAIN * n_bfs**2 / centres**1.5
+    psi = np.exp(-widths * (phase[:, None] - centres) ** 2)
+    forcing = phase[:, None] * (psi @ weights.T) / psi.sum(axis=1, keepdims=True)  # (n, d)
+    gain = ALPHA_Y * BETA_Y * STUDY_DT**2  # 0.0625
+    y = start.astype(float).copy()
+    out = np.empty((n_steps, y.size))
+    for k in range(n_steps):
+        y = y + gain * (end - y) + STUDY_DT**2 * forcing[k]
+        out[k] = y
+    return out.T
+
+
+DMP_KINDS = ("study", "project")
+
+
 @functools.lru_cache(maxsize=8)
-def _response_matrix(n_bfs: int, n_steps: int) -> np.ndarray:
+def _response_matrix(n_bfs: int, n_steps: int, kind: str = "project") -> np.ndarray:
     """(2 + n_bfs, n_steps): the trajectory of a unit start, a unit end and each unit weight.
 
     The DMP is linear in (start, end, weights) from rest velocity, so integrating each unit
     input once turns every later rollout into one matrix product.
     """
+    if kind not in DMP_KINDS:
+        raise ValueError(f"unknown DMP {kind!r}: one of {DMP_KINDS}")
     eye = np.eye(2 + n_bfs)
-    return _integrate(eye[:, 0], eye[:, 1], eye[:, 2:], n_steps)
+    integrate = _integrate_study if kind == "study" else _integrate
+    return integrate(eye[:, 0], eye[:, 1], eye[:, 2:], n_steps)
 
 
 def rollout(
-    start: np.ndarray, end: np.ndarray, weights: np.ndarray, n_steps: int = N_STEPS
+    start: np.ndarray,
+    end: np.ndarray,
+    weights: np.ndarray,
+    n_steps: int = N_STEPS,
+    kind: str = "project",
 ) -> np.ndarray:
     """Trajectories of `d` DMPs.
 
@@ -76,7 +119,7 @@ def rollout(
     """
     weights = np.atleast_2d(np.asarray(weights, dtype=float))
     inputs = np.column_stack([np.asarray(start, float), np.asarray(end, float), weights])
-    return inputs @ _response_matrix(weights.shape[1], n_steps)
+    return inputs @ _response_matrix(weights.shape[1], n_steps, kind)
 
 
 def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
@@ -87,7 +130,7 @@ def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.nda
     """
     per_joint = np.asarray(m, dtype=float).reshape(N_JOINTS, ARM_BASIS_FUNCTIONS + 1)
     weights = per_joint[:, :-1] * config.dmp_weight_scale
-    traj = rollout(np.zeros(N_JOINTS), per_joint[:, -1], weights, N_STEPS)
+    traj = rollout(np.zeros(N_JOINTS), per_joint[:, -1], weights, N_STEPS, config.dmp)
     return np.pi * np.clip(traj, -1.0, 1.0)
 
 
@@ -98,5 +141,5 @@ def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.n
     """
     per_art = np.asarray(m, dtype=float).reshape(N_ARTICULATORS, VOICE_BASIS_FUNCTIONS + 2)
     weights = per_art[:, 2:] * config.dmp_weight_scale
-    traj = rollout(per_art[:, 0], per_art[:, 1], weights, N_STEPS)
+    traj = rollout(per_art[:, 0], per_art[:, 1], weights, N_STEPS, config.dmp)
     return np.clip(traj, -1.0, 1.0)

@@ -44,6 +44,10 @@ class GraspBackend(abc.ABC):
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         """Look at the world after the step and attach what the rules say."""
 
+    def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """A control step of a vocal movement, the arm at rest: nothing is grasped."""
+        return []
+
     @abc.abstractmethod
     def release(self, physics: PlayroomPhysics) -> None:
         """Drop everything where it is and put the arm back at rest."""
@@ -85,9 +89,22 @@ class KinematicGrasp(GraspBackend):
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         return []
 
+    def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """With the study's catch rule, the resting hand takes a stick whose handle lies
+        within the grasp distance (the study's code checks it in vocal movements too)."""
+        if self.config.catch_rule != "study" or self.hand_holds is not None:
+            return []
+        positions = physics.tracked_positions()
+        if np.hypot(*(positions[1] - positions[0])) >= self.config.grasp_distance:
+            return []
+        self.hand_holds = "stick"
+        self._carry(physics)
+        return [ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand")]
+
     def _attach_by_distance(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
-        """The study's rules: a free hand takes the stick, else the first toy within reach; a
-        held stick's tip catches the first free toy within reach if it holds none."""
+        """The study's rules: a free hand takes the stick, else the first toy within reach; the
+        stick's tip catches the first free toy within reach if it holds none: a held stick's
+        only (catch_rule "held_stick"), or the stick wherever it is ("study")."""
         cfg = self.config
         events: list[ev.Event] = []
         positions = physics.tracked_positions()  # hand, handle, toy1-3
@@ -104,9 +121,9 @@ class KinematicGrasp(GraspBackend):
                     self.hand_holds = TOYS[first - 1]
                     free[first - 1] = False
                     events.append(ev.Event(ev.TOY_GRASPED, step, obj=TOYS[first - 1], by="hand"))
-        # A stick lying on the table catches nothing: only a stick in the hand is a tool.
-        if self.hand_holds == "stick" and self.stick_holds is None:
-            tip = self._held_stick_tip(physics)
+        held = self.hand_holds == "stick"
+        if (held or cfg.catch_rule == "study") and self.stick_holds is None:
+            tip = self._held_stick_tip(physics) if held else physics.stick_tip()
             near = (np.hypot(*(positions[2:] - tip).T) < cfg.catch_distance) & free
             if near.any():
                 self.stick_holds = int(np.argmax(near))
@@ -124,6 +141,10 @@ class KinematicGrasp(GraspBackend):
     def _carry(self, physics: PlayroomPhysics) -> None:
         """Place held objects: the handle at the hand, toys at the hand or the stick's tip."""
         if self.hand_holds is None:
+            if self.stick_holds is not None:  # a toy caught by the lying stick, at its tip
+                poses = physics.object_poses()
+                poses[1 + self.stick_holds, :2] = physics.stick_tip()
+                physics.set_object_poses(poses)
             return
         poses = physics.object_poses()
         if self.hand_holds == "stick":

@@ -48,38 +48,77 @@ def arm_movement(
     positions[:, 0] = hand
     positions[:, 1] = stick_pose[:2]
     positions[:, 2:] = toys
-    final_stick = np.array(stick_pose, dtype=float)
     events: list[ev.Event] = []
+    free = np.ones(len(TOYS), dtype=bool)
+    on_stick = None  # the toy on the stick's tip
     # Until the hand takes something nothing moves, so every distance is to a still object.
     near = np.empty((N_STEPS, 1 + len(TOYS)), dtype=bool)
     near[:, 0] = np.hypot(*(stick_pose[:2] - hand).T) < config.grasp_distance
     for i in range(len(TOYS)):
         near[:, 1 + i] = np.hypot(*(toys[i] - hand).T) < config.grasp_distance
     grab_steps = np.flatnonzero(near.any(axis=1))
-    if grab_steps.size == 0:
+    k = int(grab_steps[0]) if grab_steps.size else N_STEPS  # 0-based: control step k + 1
+    first = int(np.argmax(near[k])) if k < N_STEPS else -1  # the stick first, then the toys
+    if config.catch_rule == "study" and not (k == 0 and first == 0):
+        # The lying stick's tip catches a toy at the first step or never (nothing moves before
+        # the hand takes something), after the hand's pick of that step, if it made one.
+        if k == 0:
+            free[first - 1] = False
+        lying_tip = stick_pose[:2] + config.stick_length * np.array(
+            [np.cos(stick_pose[2]), np.sin(stick_pose[2])]
+        )
+        caught = (np.hypot(*(toys - lying_tip).T) < config.catch_distance) & free
+        if caught.any():
+            on_stick = int(np.argmax(caught))
+            positions[:, 2 + on_stick] = lying_tip
+            free[on_stick] = False
+            events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
+            if k > 0:  # the hand's first grasp comes later: the caught toy is no longer free
+                near[:, 1:] &= free
+                grab_steps = np.flatnonzero(near.any(axis=1))
+                k = int(grab_steps[0]) if grab_steps.size else N_STEPS
+                first = int(np.argmax(near[k])) if k < N_STEPS else -1
+    final_stick = np.array(stick_pose, dtype=float)
+    if k == N_STEPS:
         return ArmMovement(positions, final_stick, events, None)
-    k = int(grab_steps[0])  # 0-based: control step k + 1
-    first = int(np.argmax(near[k]))  # the stick first, then the toys in order
     if first > 0:
         toy = first - 1
         positions[k:, 2 + toy] = hand[k:]
-        events.append(ev.Event(ev.TOY_GRASPED, k + 1, obj=TOYS[toy], by="hand"))
-        return ArmMovement(positions, final_stick, events, TOYS[toy])
+        events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=TOYS[toy], by="hand"))
+        return ArmMovement(positions, final_stick, _in_step_order(events), TOYS[toy])
     events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
     positions[k:, 1] = hand[k:]
     final_stick = np.array([*hand[-1], yaw[-1]])
-    # The held stick points along the hand: its tip catches the first toy within reach.
+    # The held stick points along the hand: its tip carries a toy caught before, or catches
+    # the first toy within reach.
     tip = hand[k:] + config.stick_length * np.stack([np.cos(yaw[k:]), np.sin(yaw[k:])], axis=1)
+    if on_stick is not None:
+        positions[k:, 2 + on_stick] = tip
+        return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
     caught = np.empty((N_STEPS - k, len(TOYS)), dtype=bool)
     for i in range(len(TOYS)):
-        caught[:, i] = np.hypot(*(toys[i] - tip).T) < config.catch_distance
+        caught[:, i] = (np.hypot(*(toys[i] - tip).T) < config.catch_distance) & free[i]
     catch_steps = np.flatnonzero(caught.any(axis=1))
     if catch_steps.size:
         c = int(catch_steps[0])
         toy = int(np.argmax(caught[c]))
         positions[k + c :, 2 + toy] = tip[c:]
         events.append(ev.Event(ev.TOY_CAUGHT, k + c + 1, obj=TOYS[toy], by="stick"))
-    return ArmMovement(positions, final_stick, events, "stick")
+    return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
+
+
+def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:
+    """Events by step; within a step, the hand's grasp before the stick's catch."""
+    order = {ev.STICK_GRASPED: 0, ev.TOY_GRASPED: 0, ev.TOY_CAUGHT: 1}
+    return sorted(events, key=lambda e: (e.step, order[e.kind]))
+
+
+def voice_grasp(config: WorldConfig, hand: np.ndarray, stick_pose: np.ndarray) -> bool:
+    """With the study's catch rule, whether the resting hand at `hand` (2,) takes the stick
+    during a vocal movement (its handle within the grasp distance)."""
+    if config.catch_rule != "study":
+        return False
+    return bool(np.hypot(*(stick_pose[:2] - hand)) < config.grasp_distance)
 
 
 def brought_path(rate: float, start: np.ndarray, target: np.ndarray) -> np.ndarray:

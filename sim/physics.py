@@ -210,3 +210,8 @@ class KinematicPhysics(PlayroomPhysics):
         out = super().tracked_positions()
         out[0] = self.hand_position()
         return out
+
+    def stick_tip(self) -> np.ndarray:
+        """The tip of the stick from its pose, by the same arithmetic as the held stick's."""
+        x, y, yaw = self.object_poses()[0]
+        return np.array([x, y]) + self.config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])

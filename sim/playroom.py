@@ -27,7 +27,7 @@ from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
 from sim.grasp import BACKENDS, make_backend
-from sim.kinematic_movement import arm_movement, brought_path
+from sim.kinematic_movement import arm_movement, brought_path, voice_grasp
 from sim.model_edits import ModelEdits
 from sim.physics import CONTROL_SUBSTEPS, KinematicPhysics, PlayroomPhysics
 from sim.task import ARM, VOICE, PlayroomTask
@@ -228,6 +228,10 @@ class Playroom:
         else:
             events = self.caregiver.hear(p, voice_formants)
             positions[1:] = positions[0]
+            if voice_grasp(self.config, positions[0, 0], poses[0]):  # the study's rule
+                events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
+                positions[1:, 1] = positions[0, 0]
+                poses[0] = (*positions[0, 0], self.config.arm_rest_offset)
             sound[:] = self.task.normalised(voice_formants)
             toy = self.caregiver.bringing
             if toy is not None:

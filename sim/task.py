@@ -63,6 +63,7 @@ class PlayroomTask(control.Task):
         if self.movement == ARM:
             self.step_events += self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
         elif self.movement == VOICE:
+            self.step_events += self.grasp.during_voice(physics, self.step_index)
             if self._planned_sound is not None:
                 self.sound = self._planned_sound[self.step_index - 1]
             else:

@@ -20,7 +20,12 @@ def test_same_seed_same_logs_as_recorded(tmp_path, grasp):
     out = tmp_path / grasp
     # The stick return (added later) changes a physical world: it is off here, as it was then.
     settings = TrialSettings(
-        grasp=grasp, iterations=ITERATIONS, seed=SEED, checkpoint_every=1000, stick_return="never"
+        grasp=grasp,
+        iterations=ITERATIONS,
+        seed=SEED,
+        checkpoint_every=1000,
+        stick_return="never",
+        preset="project",  # the choices the logs were recorded with
     )
     run_trial(out, settings, progress=False)
     for kind in ("iterations", "words"):

@@ -43,7 +43,9 @@ def test_run_writes_config_checkpoint_and_logs(tmp_path, grasp):
     assert trial.iteration == 120
     config = storage.read_json(out / "config.json")
     assert config["trial"]["seed"] == 1 and config["trial"]["grasp"] == grasp
-    assert "package_version" in config and config["learner"]["exploration_sigma"] == 0.05
+    # The default preset is the study's code: its sigma, its DMP, its catch rule.
+    assert "package_version" in config and config["learner"]["exploration_sigma"] == 0.1
+    assert config["world"]["dmp"] == "study" and config["world"]["catch_rule"] == "study"
     log = read_log(out)
     assert list(log["iteration"]) == list(range(120))
     assert set(log["motor_space"]) <= {"arm", "voice"}

@@ -36,7 +36,7 @@ def dmp_response(world: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
     (start, end, each weight in [-1, 1] units), before clipping. The DMP is linear in them."""
     n_in = 2 + VOICE_BASIS_FUNCTIONS
     eye = np.eye(n_in)
-    return rollout(eye[:, 0], eye[:, 1], eye[:, 2:] * world.dmp_weight_scale, N_STEPS)
+    return rollout(eye[:, 0], eye[:, 1], eye[:, 2:] * world.dmp_weight_scale, N_STEPS, world.dmp)
 
 
 def initial_guess(word: str, tract: VocalTract) -> np.ndarray:
