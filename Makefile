@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
 OUT ?= runs
 
-.PHONY: install run test test-slow lint format bench voice-model experiment compare video clean
+.PHONY: install run test test-slow lint format bench voice-model experiment compare video replicate clean
 
 $(INSTALLED): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -36,6 +36,12 @@ compare: $(INSTALLED)
 video: $(INSTALLED)
 	$(BIN)/playroom batch --profile demo --out $(DEMO)
 	$(BIN)/playroom render $(DEMO)/physical-random-seed0000 --highlights --out $(OUT)/highlights.mp4
+
+## replicate: the replication profile (kinematic, study preset, 100 seeds x 80000) and its report;
+## rerunning resumes where it stopped
+replicate: $(INSTALLED)
+	$(BIN)/playroom batch --profile replication --out $(OUT)/replication
+	$(BIN)/playroom report $(OUT)/replication
 
 ## test: lint, then the test suite (under 5 minutes on 2 cores)
 test: lint

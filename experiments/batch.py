@@ -27,7 +27,7 @@ from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
 from experiments.lock import DirectoryLock
 from experiments.trial import CHECKPOINT_FILE, TrialSettings, run_trial
 
-PROFILES = ("smoke", "demo", "paper")
+PROFILES = ("smoke", "demo", "paper", "replication")
 TIMING_FILE = "timing.json"
 # How long to wait for a scheduler that does not answer.
 CONNECT_TIMEOUT_S = 10

@@ -144,3 +144,7 @@ def test_stored_profiles_hold_what_the_readme_says():
     assert demo.iterations == 20000
     assert len(paper.seeds) == 500 and paper.iterations == 80000 and len(paper.trials()) == 1000
     assert paper.eval_placements == 100
+    replication = load_spec("replication")
+    assert replication.grasps == ("kinematic",) and len(replication.seeds) == 100
+    assert replication.iterations == 80000 and replication.preset == "study"
+    assert all(s.preset == "study" for _, s in replication.trials())
