@@ -185,7 +185,7 @@ def cmd_report(args: argparse.Namespace) -> None:
     from experiments.report import ReportError, write_report
 
     try:
-        print(write_report(args.dir, args.out))
+        print(write_report(args.dir, args.out, args.study_reference_commands))
     except ReportError as exc:
         raise UsageError(str(exc)) from None
 
@@ -195,7 +195,14 @@ def cmd_compare(args: argparse.Namespace) -> None:
     from experiments.report import ReportError, write_comparison
 
     try:
-        print(write_comparison(args.dir_a, args.dir_b, args.out))
+        print(
+            write_comparison(
+                args.dir_a,
+                args.dir_b,
+                args.out,
+                study_reference_commands=args.study_reference_commands,
+            )
+        )
     except ReportError as exc:
         raise UsageError(str(exc)) from None
 
@@ -252,6 +259,16 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _study_reference_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--study-reference-commands",
+        type=_positive_int,
+        default=10000,
+        metavar="N",
+        help="random commands per ring behind the study's own measure (the study's: 10000)",
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="playroom", description="A MuJoCo playroom for Model Babbling of tool use and speech."
@@ -306,12 +323,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="figures and report.html of a batch beside the paper")
     p.add_argument("dir", help="a batch directory of evaluated trials")
     p.add_argument("--out", help="where to write (default: DIR)")
+    _study_reference_option(p)
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("compare", help="kinematic vs physical batches side by side")
     p.add_argument("dir_a", help="a batch directory (e.g. the kinematic one)")
     p.add_argument("dir_b", help="another batch directory, or DIR_A again if it holds both")
     p.add_argument("--out", required=True, help="where to write comparison.html")
+    _study_reference_option(p)
     p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")

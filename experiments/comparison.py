@@ -43,6 +43,7 @@ from experiments.statistics import (
     welch,
 )
 from experiments.stick import grasp_rates
+from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
 
 COMPARISON_FILE = "comparison.html"
 # Random arm commands behind the comparison's stick-grasp rates of the two backends.
@@ -246,6 +247,7 @@ def write_comparison(
     dir_b: str | os.PathLike,
     out_dir: str | os.PathLike,
     grasp_rate_commands: int = GRASP_RATE_COMMANDS,
+    study_reference_commands: int = RANDOM_COMMANDS_PER_RING,
 ) -> Path:
     """Two batches (e.g. kinematic and physical grasping) side by side: every figure with one
     panel per batch, the paper table with both, tests of their differences and the cost per
@@ -257,6 +259,7 @@ def write_comparison(
     merged = a.merge(b)
     geometry = Geometry.of(merged)
     numbers = summarise(merged, geometry)
+    numbers["study"] = study_numbers(merged, study_reference_commands)
     published = paper.published()
     figures = [
         FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png)

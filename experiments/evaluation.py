@@ -36,6 +36,8 @@ from sim.vocal.config import DEFAULT_VOICE
 EVAL_FILE = "eval.json"
 COMPETENCE_FILE = "competence.parquet"
 VOCAL_FILE = "vocal.parquet"
+# The tests of the study's own measure (experiments/study_measure.py).
+STUDY_TESTS_FILE = "study-tests.parquet"
 # Times at which the goal trajectory samples the toy's way to the centre (docs/protocol.md §10).
 GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
 # Evaluation placements come from their own seed, the same for every trial and backend, so
@@ -206,8 +208,14 @@ def evaluate_trial(
         summary = summarise(config, competence, vocal)
         summary["evaluated_at_iteration"] = int(meta["iteration"])
         summary["n_placements"] = settings.n_placements
+        # The study measured in the scene learning left, carried over from test to test.
+        from experiments.study_measure import StudyMeasureSettings, study_tests
+
+        _, final_agent, final_room, _ = load_trial(trial_dir)
+        study = study_tests(final_agent, final_room, StudyMeasureSettings(settings.n_placements))
         storage.write_table(trial_dir / COMPETENCE_FILE, competence)
         storage.write_table(trial_dir / VOCAL_FILE, vocal)
+        storage.write_table(trial_dir / STUDY_TESTS_FILE, study)
         storage.write_json(trial_dir / EVAL_FILE, summary)
     finally:
         lock.release()

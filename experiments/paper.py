@@ -121,6 +121,7 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
             paper["strategy_distance_1"].text,
             *shares_of("distance 1"),
         ],
+        *_study_rows(g, numbers.get("study", {}), paper),
         [
             f"Words imitated within {t:g} (best distance)",
             paper["words_below_threshold"].text,
@@ -140,6 +141,52 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
             "Mann-Whitney U, names vs distractors (two-sided)",
             paper["mann_whitney_p"].text,
             *[f"U = {num(vocal[x]['u'], 1)}, {p_value(vocal[x]['p'])}" for x in g],
+        ],
+    ]
+
+
+def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
+    """The paper's competence and strategy numbers beside the study's own measure of each
+    group (experiments/study_measure.py); none if no group has the study's tests."""
+    if not study:
+        return []
+
+    def of(group: str, pick) -> str:
+        return pick(study[group]) if group in study else "not measured"
+
+    def shares(region: str):
+        def text(numbers: dict) -> str:
+            share = numbers["strategy_share"].get(region, {})
+            return " / ".join(pct(share.get(k, 0.0)) for k in ("hand", "tool", "vocal"))
+
+        return text
+
+    label = "as the study computed it"
+    return [
+        [
+            f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random))",
+            paper["competence_all"].text,
+            *[of(x, lambda n: pct(n["competence"]["all"])) for x in groups],
+        ],
+        *[
+            [f"… ring {r}, {label}", NOT_PUBLISHED]
+            + [of(x, lambda n, r=r: pct(n["competence"][f"ring{r}"])) for x in groups]
+            for r in (1, 2, 3)
+        ],
+        [
+            f"Strategy hand / tool / vocal, centre (d < 0.6), {label}",
+            paper["strategy_centre"].text,
+            *[of(x, shares("centre")) for x in groups],
+        ],
+        [
+            f"Strategy hand / tool / vocal, between the limits (0.6 ≤ d < 0.85), {label}",
+            paper["strategy_between_limits"].text,
+            *[of(x, shares("between_limits")) for x in groups],
+        ],
+        [
+            f"Strategy hand / tool / vocal, distance 1 (0.98 ≤ d < 1), {label}",
+            paper["strategy_distance_1"].text,
+            *[of(x, shares("distance_1")) for x in groups],
         ],
     ]
 

@@ -19,6 +19,7 @@ from experiments.figures import report_figures
 from experiments.report_html import render, settings_table, trials_table, write_page
 from experiments.results import Geometry, ReportError, collect
 from experiments.statistics import summarise
+from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
 
 # The CLI imports ReportError, write_report and write_comparison from here.
 __all__ = ["COMPARISON_FILE", "REPORT_FILE", "ReportError", "write_comparison", "write_report"]
@@ -26,13 +27,19 @@ __all__ = ["COMPARISON_FILE", "REPORT_FILE", "ReportError", "write_comparison", 
 REPORT_FILE = "report.html"
 
 
-def write_report(batch_dir: str | os.PathLike, out_dir: str | os.PathLike | None = None) -> Path:
+def write_report(
+    batch_dir: str | os.PathLike,
+    out_dir: str | os.PathLike | None = None,
+    study_reference_commands: int = RANDOM_COMMANDS_PER_RING,
+) -> Path:
     """Figures (PNG) and `report.html` of a batch, its numbers beside the paper's; into
     `out_dir` (default: the batch directory). Returns the path of report.html. ReportError
-    (one line) for a batch that cannot be reported on; nothing is written then."""
+    (one line) for a batch that cannot be reported on; nothing is written then.
+    `study_reference_commands`: random commands per ring of the study's own measure."""
     results = collect(batch_dir)
     geometry = Geometry.of(results)
     numbers = summarise(results, geometry)
+    numbers["study"] = study_numbers(results, study_reference_commands)
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
     page = render(

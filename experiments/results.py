@@ -23,7 +23,7 @@ import pandas as pd
 
 from experiments import storage
 from experiments.curves import curve_rows, tool_numbers
-from experiments.evaluation import COMPETENCE_FILE, EVAL_FILE, VOCAL_FILE
+from experiments.evaluation import COMPETENCE_FILE, EVAL_FILE, STUDY_TESTS_FILE, VOCAL_FILE
 from experiments.trial import CONFIG_FILE, read_log
 
 TIMING_FILE = "timing.json"
@@ -57,6 +57,9 @@ class BatchResults:
     vocal: pd.DataFrame
     curves: pd.DataFrame
     configs: dict[str, dict]
+    study_tests: pd.DataFrame = dataclasses.field(
+        default_factory=lambda: pd.DataFrame(columns=["group"])
+    )
 
     @property
     def groups(self) -> list[str]:
@@ -91,6 +94,7 @@ class BatchResults:
             "competence": self.competence,
             "vocal": self.vocal,
             "curves": self.curves,
+            "study_tests": self.study_tests,
         }
 
 
@@ -252,8 +256,9 @@ def _timing(trial_dir: Path) -> tuple[float, float]:
 
 def _trial_rows(
     d: Path, config: dict, summary: dict, label: str
-) -> tuple[dict[str, Any], pd.DataFrame, pd.DataFrame, pd.DataFrame]:
-    """(trials row, competence rows, vocal rows, curve rows) of one trial directory."""
+) -> tuple[dict[str, Any], pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
+    """(trials row, competence rows, vocal rows, curve rows, the study's test rows or None) of
+    one trial directory."""
     keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
     comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
     voc = _read_table(d / VOCAL_FILE).assign(**keys)
@@ -275,7 +280,9 @@ def _trial_rows(
         "seconds": seconds,
         "timed_iterations": timed,
     }
-    return row, comp, voc, curve
+    study_path = d / STUDY_TESTS_FILE  # trials evaluated before it existed have none
+    study = _read_table(study_path).assign(**keys) if study_path.exists() else None
+    return row, comp, voc, curve, study
 
 
 def collect(batch_dir: str | os.PathLike) -> BatchResults:
@@ -311,7 +318,8 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         _trial_rows(d, config, summary, label)
         for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
     ]
-    trials, competence, vocal, curves = zip(*rows, strict=True)
+    trials, competence, vocal, curves, study = zip(*rows, strict=True)
+    studied = [t for t in study if t is not None]
     return BatchResults(
         batch_dir=batch_dir,
         trials=pd.DataFrame(list(trials)),
@@ -319,4 +327,7 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         vocal=pd.concat(vocal, ignore_index=True),
         curves=pd.concat(curves, ignore_index=True),
         configs=group_configs,
+        study_tests=(
+            pd.concat(studied, ignore_index=True) if studied else pd.DataFrame(columns=["group"])
+        ),
     )

@@ -98,7 +98,7 @@ def test_collect_reads_every_trial_into_tables(batches):
 
 def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     out = tmp_path / "report"
-    page = write_report(batches["kinematic"], out)
+    page = write_report(batches["kinematic"], out, study_reference_commands=20)
     assert page == out / REPORT_FILE
     _embedded(page, out, "*.png")
     text = page.read_text()
@@ -114,7 +114,9 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     for trial in batch_b.iterdir():  # one side recorded its cost, the other did not
         (trial / "timing.json").write_text(json.dumps({"seconds": 1.5, "iterations": 300}))
     out = tmp_path / "compare"
-    page = write_comparison(batches["kinematic"], batch_b, out, grasp_rate_commands=20)
+    page = write_comparison(
+        batches["kinematic"], batch_b, out, grasp_rate_commands=20, study_reference_commands=20
+    )
     assert page == out / COMPARISON_FILE
     _embedded(page, out, "comparison-*.png")
     text = page.read_text()
@@ -319,7 +321,9 @@ def _row(page: str, first_cell: str) -> list[str]:
 
 def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypatch):
     results = collect(batches["kinematic"])
-    page = write_report(batches["kinematic"], tmp_path / "report").read_text()
+    page = write_report(
+        batches["kinematic"], tmp_path / "report", study_reference_commands=20
+    ).read_text()
     published = paper.published()
     result, theirs, ours = _row(page, "Normalised competence, all rings")
     assert theirs == published["competence_all"].text == "46% better than random on average"
@@ -329,7 +333,9 @@ def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypat
     # The paper column is read from the data file, not written into the code.
     edited = dataclasses.replace(published["competence_all"], text="12% <b>edited</b>")
     monkeypatch.setattr(paper, "published", lambda: {**published, "competence_all": edited})
-    page = write_report(batches["kinematic"], tmp_path / "edited").read_text()
+    page = write_report(
+        batches["kinematic"], tmp_path / "edited", study_reference_commands=20
+    ).read_text()
     assert _row(page, "Normalised competence, all rings")[1] == "12% <b>edited</b>"
 
 
@@ -339,7 +345,7 @@ def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
         config = json.loads(config_path.read_text())
         config["trial"]["grasp"] = "<script>alert(1)</script>"
         config_path.write_text(json.dumps(config))
-    text = write_report(batch, tmp_path / "out").read_text()
+    text = write_report(batch, tmp_path / "out", study_reference_commands=20).read_text()
     assert "<script>" not in text and "<b>batch" not in text
     assert "this batch: &lt;script&gt;alert(1)&lt;/script&gt;" in text
     assert "&lt;b&gt;batch" in text

@@ -1,0 +1,182 @@
+"""Competence and strategies as the study computed them (docs/protocol.md §10, D20-D23), its
+quirks reproduced, for comparison with the paper beside the project's own measure.
+
+How the study's code measured (its scripts/run.py and analysis notebooks):
+- tests: per ring, 100 placements of all 3 toys in the ring, one test per toy, in one scene
+  that carries over: the stick stays where the last test left it, moved toys stay moved, the
+  caregiver is redrawn after every movement and the room's own counter re-places every toy
+  every 20 movements; the goal is the toy's current position moved straight to the base;
+- strategy: the arm or the voice model of the toy, whichever has the nearer experience (a tie
+  goes to the voice); when the voice model had data, the arm model's inverse was queried with
+  the voice model's context values (toy, caregiver) in place of its own (stick, toy);
+- a test used the tool when the stick's x moved between the first and the last sample;
+- random reference: 10000 random commands per ring (arm or voice, 1/2 each), whose error was
+  read on toy 1's trajectory whatever the goal toy;
+- map: errors on a 100 x 100 grid over [-1, 1]^2 by the toy's position, the reference averaged
+  over one-pixel rings around the base, and per pixel max(0, 1 - agent / random). How the
+  paper's "46%" averaged the pixels is not in the study's notebooks: here, the mean over every
+  pixel that holds a test.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from experiments.evaluation import goal_trajectory, strategy_of
+from learner.agent import Agent
+from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
+from sim import Playroom
+
+GRID = 100  # pixels a side over [-1, 1]^2
+RANDOM_COMMANDS_PER_RING = 10000
+# The study's strategy regions (m): within the hand's reach plus its grasp distance, within the
+# stick's, and "distance 1", its last one-pixel ring.
+HAND_LIMIT, STICK_LIMIT, DISTANCE_ONE = 0.6, 0.85, (0.98, 1.0)
+
+
+@dataclass(frozen=True)
+class StudyMeasureSettings:
+    n_placements: int = 100
+    random_commands_per_ring: int = RANDOM_COMMANDS_PER_RING
+    seed: int = 20170001
+
+
+def _ring_placement(room: Playroom, ring: tuple[float, float], rng) -> np.ndarray:
+    """(3, 2) toys uniform in the ring (the study's `reset_toys(region)`: no clearance)."""
+    radius = rng.uniform(*ring, size=len(TOYS))
+    angle = rng.uniform(0.0, 2 * np.pi, size=len(TOYS))
+    return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=1)
+
+
+def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
+    """A context whose arm-model slots (stick, toy) hold the voice model's values (toy,
+    caregiver): what the study's arm inverse was queried with when the voice had data."""
+    swapped = context.copy()
+    swapped[list(context_indices("stick"))] = context[list(context_indices(toy))]
+    swapped[list(context_indices(toy))] = context[list(context_indices("caregiver"))]
+    return swapped
+
+
+def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
+    """One row per test: ring, toy, x, y (the toy's position), strategy, error."""
+    rng = np.random.default_rng(settings.seed)
+    rows = []
+    for ring_number, ring in enumerate(room.config.toy_rings, start=1):
+        for _ in range(settings.n_placements):
+            room.arrange(toys=_ring_placement(room, ring, rng))
+            for t, toy in enumerate(TOYS, start=1):
+                context = room.context()
+                position = context[list(context_indices(toy))]
+                goal = goal_trajectory(position)
+                arm, voice = agent.toy_models(t)
+                d_arm = agent.nearest_distance(arm, context, goal)
+                d_voice = agent.nearest_distance(voice, context, goal)
+                if d_arm < d_voice:
+                    asked = (
+                        context if np.isinf(d_voice) else _arm_context_of_the_study(context, toy)
+                    )
+                    space, m = "arm", agent.exploit(arm, asked, goal)
+                elif np.isfinite(d_voice):
+                    space, m = "voice", agent.exploit(voice, context, goal)
+                else:  # neither model has data: the arm at rest
+                    space, m = "arm", np.zeros(MOTOR_DIMS["arm"])
+                s = room.act(space, m).s
+                stick_x = s[block_slice("stick")][:5]
+                rows.append(
+                    {
+                        "ring": ring_number,
+                        "toy": t,
+                        "x": position[0],
+                        "y": position[1],
+                        "strategy": strategy_of(space, bool(stick_x[0] != stick_x[-1])),
+                        "error": float(np.linalg.norm(s[block_slice(toy)] - goal)),
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def random_reference(room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
+    """One row per random command: x, y of the goal toy and the error read on toy 1."""
+    rng = np.random.default_rng(settings.seed + 1)
+    rows = []
+    for ring in room.config.toy_rings:
+        for k in range(settings.random_commands_per_ring):
+            if k % len(TOYS) == 0:
+                room.arrange(toys=_ring_placement(room, ring, rng))
+            context = room.context()
+            toy = TOYS[k % len(TOYS)]
+            position = context[list(context_indices(toy))]
+            space = "arm" if rng.random() < 0.5 else "voice"
+            s = room.act(space, rng.uniform(-1, 1, MOTOR_DIMS[space])).s
+            error = float(np.linalg.norm(s[block_slice("toy1")] - goal_trajectory(position)))
+            rows.append({"x": position[0], "y": position[1], "error": error})
+    return pd.DataFrame(rows)
+
+
+def _pixels(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel indices (i, j) of the rows' x, y on the GRID x GRID map of [-1, 1]^2."""
+    i = np.clip(((table["x"].to_numpy() + 1) / 2 * GRID).astype(int), 0, GRID - 1)
+    j = np.clip(((table["y"].to_numpy() + 1) / 2 * GRID).astype(int), 0, GRID - 1)
+    return i, j
+
+
+def competence_map(tests: pd.DataFrame, reference: pd.DataFrame) -> np.ndarray:
+    """(GRID, GRID) per-pixel competence max(0, 1 - agent error / random error), NaN where no
+    test fell; the random error of a pixel is the mean over its one-pixel ring."""
+    i, j = _pixels(tests)
+    sums, counts = np.zeros((GRID, GRID)), np.zeros((GRID, GRID))
+    np.add.at(sums, (i, j), tests["error"].to_numpy())
+    np.add.at(counts, (i, j), 1)
+    ri, rj = _pixels(reference)
+    ring_of = np.rint(np.hypot(ri - GRID / 2, rj - GRID / 2)).astype(int)
+    ring_sum = np.bincount(ring_of, weights=reference["error"].to_numpy(), minlength=GRID)
+    ring_count = np.bincount(ring_of, minlength=GRID)
+    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
+    pixel_ring = np.rint(np.hypot(gi - GRID / 2, gj - GRID / 2)).astype(int)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        random_error = (ring_sum / ring_count)[np.minimum(pixel_ring, len(ring_sum) - 1)]
+        agent_error = sums / counts
+        return np.where(counts > 0, np.maximum(0.0, 1.0 - agent_error / random_error), np.nan)
+
+
+def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
+    """The study's numbers: mean per-pixel competence (all rings and per ring) and the
+    strategy shares of its regions."""
+    summary = {"competence": {"all": float(np.nanmean(competence_map(tests, reference)))}}
+    for ring, table in tests.groupby("ring"):
+        summary["competence"][f"ring{ring}"] = float(np.nanmean(competence_map(table, reference)))
+    distance = np.hypot(tests["x"], tests["y"])
+    regions = {
+        "centre": distance < HAND_LIMIT,
+        "between_limits": (distance >= HAND_LIMIT) & (distance < STICK_LIMIT),
+        "distance_1": (distance >= DISTANCE_ONE[0]) & (distance < DISTANCE_ONE[1]),
+    }
+    summary["strategy_share"] = {
+        name: tests.loc[mask, "strategy"].value_counts(normalize=True).to_dict()
+        for name, mask in regions.items()
+    }
+    return summary
+
+
+def study_numbers(results, commands_per_ring: int = RANDOM_COMMANDS_PER_RING) -> dict[str, dict]:
+    """`study_summary` of each group of a batch (`experiments.results.BatchResults`) whose
+    trials hold the study's tests: their tests pooled over trials (the study averaged errors
+    per pixel over its runs), against a random reference played in a fresh room of the
+    group's settings."""
+    from experiments.trial import fresh_trial_parts
+
+    numbers = {}
+    for group, config in results.configs.items():
+        tests = results.study_tests[results.study_tests["group"] == group]
+        if tests.empty:
+            continue
+        try:
+            _, room = fresh_trial_parts({**config, "trial": {**config["trial"], "seed": 0}})
+        except ValueError:  # settings no room can be built from: the row says "not measured"
+            continue
+        settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
+        numbers[group] = study_summary(tests, random_reference(room, settings))
+    return numbers
