@@ -52,6 +52,7 @@ class BatchSpec:
     eval_placements: int = 100
     stick_return: str = "out_of_reach"
     preset: str = "study"
+    overrides: dict = field(default_factory=dict)
     description: str = field(default="", compare=False)
 
     def trials(self) -> list[tuple[str, TrialSettings]]:
@@ -69,6 +70,7 @@ class BatchSpec:
                         checkpoint_every=min(self.checkpoint_every, self.iterations),
                         stick_return=self.stick_return,
                         preset=self.preset,
+                        overrides=self.overrides,
                     )
                     out.append((name, settings))
         return out
@@ -110,6 +112,7 @@ def load_spec(
             eval_placements=int(raw.get("eval_placements", 100)),
             stick_return=str(raw.get("stick_return", "out_of_reach")),
             preset=str(raw.get("preset", "study")),
+            overrides=dict(raw.get("overrides", {})),
             description=raw.get("description", ""),
         )
         spec.trials()  # validates every trial's settings

@@ -70,12 +70,18 @@ class TrialSettings:
     # "study": the world and learner as the study's code behaved; "project": this project's
     # earlier choices (sim.config.world_preset, learner.config.learner_preset).
     preset: str = "study"
+    # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
+    # departure switched at a time (ablations, docs/replication.md).
+    overrides: dict = dataclasses.field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.grasp not in ("kinematic", "physical"):
             raise TrialError(f"unknown grasp {self.grasp!r}: 'kinematic' or 'physical'")
         if self.preset not in PRESETS:
             raise TrialError(f"unknown preset {self.preset!r}: one of {', '.join(PRESETS)}")
+        unknown = sorted(set(self.overrides) - {"world", "learner"})
+        if unknown:
+            raise TrialError(f"overrides of unknown sections {unknown}: 'world' or 'learner'")
         if self.stick_return not in STICK_RETURNS:
             raise TrialError(
                 f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
@@ -96,8 +102,16 @@ def full_config(
 ) -> dict:
     """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
     the trial's room and agent from."""
-    learner = learner or learner_preset(settings.preset, babbling=settings.babbling)
-    world = world or world_preset(settings.preset, stick_return=settings.stick_return)
+    changes = settings.overrides
+    try:
+        learner = learner or learner_preset(
+            settings.preset, **{"babbling": settings.babbling, **changes.get("learner", {})}
+        )
+        world = world or world_preset(
+            settings.preset, **{"stick_return": settings.stick_return, **changes.get("world", {})}
+        )
+    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
+        raise TrialError(f"overrides do not fit the configs: {exc}") from None
     config = {
         "trial": dataclasses.asdict(settings),
         "world": dataclasses.asdict(world),

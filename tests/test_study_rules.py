@@ -155,3 +155,18 @@ def test_the_study_bootstrap_tosses_coins_learns_nothing_and_waits_for_two_outco
             inferred.add(proposal.inferred)
             agent.learn(proposal, context, np.zeros(60))
         assert inferred == {value == 0.2}
+
+
+def test_a_trial_can_switch_one_departure_back(tmp_path):
+    from experiments import storage
+    from experiments.trial import TrialError, TrialSettings, run_trial
+
+    overrides = {"learner": {"exploration_sigma": 0.05}, "world": {"dmp": "project"}}
+    settings = TrialSettings(iterations=5, overrides=overrides)
+    run_trial(tmp_path / "t", settings, progress=False)
+    config = storage.read_json(tmp_path / "t" / "config.json")
+    assert config["learner"]["exploration_sigma"] == 0.05 and config["world"]["dmp"] == "project"
+    assert config["learner"]["storing_rule"] == "varies_about_mean"  # the rest: the study's
+    with pytest.raises(TrialError, match="overrides"):
+        run_trial(tmp_path / "u", TrialSettings(overrides={"learner": {"sigma": 1}}))
+    assert not (tmp_path / "u" / "config.json").exists()
