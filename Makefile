@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
 OUT ?= runs
 
-.PHONY: install run test test-slow lint format bench voice-model experiment compare video replicate clean
+.PHONY: install run test test-slow lint format bench voice-model experiment compare video replicate ablations clean
 
 $(INSTALLED): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -42,6 +42,12 @@ video: $(INSTALLED)
 replicate: $(INSTALLED)
 	$(BIN)/playroom batch --profile replication --out $(OUT)/replication
 	$(BIN)/playroom report $(OUT)/replication
+
+## ablations: each departure from the study switched back alone (32 seeds x 80000 each)
+ablations: $(INSTALLED)
+	for f in experiments/ablations/*.json; do \
+		$(BIN)/playroom batch --config $$f --out $(OUT)/ablation-$$(basename $$f .json) || exit 1; \
+	done
 
 ## test: lint, then the test suite (under 5 minutes on 2 cores)
 test: lint
