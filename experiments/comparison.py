@@ -259,7 +259,9 @@ def write_comparison(
     merged = a.merge(b)
     geometry = Geometry.of(merged)
     numbers = summarise(merged, geometry)
-    numbers["study"] = study_numbers(merged, study_reference_commands)
+    numbers["study"] = study_numbers(
+        merged, study_reference_commands, Path(out_dir), also_look_in=(dir_a, dir_b)
+    )
     published = paper.published()
     figures = [
         FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png)

@@ -39,7 +39,7 @@ def write_report(
     results = collect(batch_dir)
     geometry = Geometry.of(results)
     numbers = summarise(results, geometry)
-    numbers["study"] = study_numbers(results, study_reference_commands)
+    numbers["study"] = study_numbers(results, study_reference_commands, results.batch_dir)
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
     page = render(

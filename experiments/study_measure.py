@@ -20,7 +20,10 @@ How the study's code measured (its scripts/run.py and analysis notebooks):
 
 from __future__ import annotations
 
+import hashlib
+import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -161,11 +164,19 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     return summary
 
 
-def study_numbers(results, commands_per_ring: int = RANDOM_COMMANDS_PER_RING) -> dict[str, dict]:
+def study_numbers(
+    results,
+    commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
+    cache_dir: Path | None = None,
+    also_look_in: tuple[Path, ...] = (),
+) -> dict[str, dict]:
     """`study_summary` of each group of a batch (`experiments.results.BatchResults`) whose
     trials hold the study's tests: their tests pooled over trials (the study averaged errors
     per pixel over its runs), against a random reference played in a fresh room of the
-    group's settings."""
+    group's settings. The reference depends on the settings alone: with `cache_dir` it is kept
+    there (`study-reference-<digest>.parquet`) and read back by later reports, which also look
+    for it in `also_look_in` (a comparison reads what the batches' reports kept)."""
+    from experiments import storage
     from experiments.trial import fresh_trial_parts
 
     numbers = {}
@@ -173,10 +184,23 @@ def study_numbers(results, commands_per_ring: int = RANDOM_COMMANDS_PER_RING) ->
         tests = results.study_tests[results.study_tests["group"] == group]
         if tests.empty:
             continue
-        try:
-            _, room = fresh_trial_parts({**config, "trial": {**config["trial"], "seed": 0}})
-        except ValueError:  # settings no room can be built from: the row says "not measured"
-            continue
-        settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
-        numbers[group] = study_summary(tests, random_reference(room, settings))
+        config = {**config, "trial": {**config["trial"], "seed": 0}}
+        key = json.dumps({"config": config, "commands": commands_per_ring}, sort_keys=True)
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        cached = (
+            None if cache_dir is None else Path(cache_dir) / f"study-reference-{digest}.parquet"
+        )
+        if cached is not None and cached.exists():
+            reference = storage.read_table(cached)
+        else:
+            try:
+                _, room = fresh_trial_parts(config)
+            except ValueError:  # settings no room can be built from: the row says "not measured"
+                continue
+            settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
+            reference = random_reference(room, settings)
+            if cached is not None:
+                cached.parent.mkdir(parents=True, exist_ok=True)
+                storage.write_table(cached, reference)
+        numbers[group] = study_summary(tests, reference)
     return numbers

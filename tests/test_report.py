@@ -372,3 +372,20 @@ def test_stick_numbers_of_a_hand_made_log():
     curves = curve_rows(log, pd.DataFrame(), iterations=4, names=set(), reach=0.6)
     in_reach = curves[curves["metric"] == "stick_in_reach"]["value"]
     assert list(in_reach) == [0.5]
+
+
+def test_the_study_reference_is_played_once_and_kept(batches, tmp_path, monkeypatch):
+    from experiments import study_measure
+
+    batch = _copy_batch(batches, tmp_path / "batch")
+    first = write_report(batch, tmp_path / "one", study_reference_commands=20).read_text()
+    assert len(list(batch.glob("study-reference-*.parquet"))) == 1
+
+    def played(*args, **kwargs):
+        raise AssertionError("the kept reference should have been read back")
+
+    monkeypatch.setattr(study_measure, "random_reference", played)
+    second = write_report(batch, tmp_path / "two", study_reference_commands=20).read_text()
+    assert "as the study computed it" in first
+    rows = [line for line in first.splitlines() if "as the study computed it" in line]
+    assert rows == [line for line in second.splitlines() if "as the study computed it" in line]
