@@ -6,7 +6,6 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -88,12 +87,18 @@ def test_the_lock_dies_with_its_holder_even_on_kill_9(lock_holder):
 
 def test_a_batch_task_waits_for_the_other_writer_then_completes(lock_holder):
     directory, holder = lock_holder
-    threading.Timer(1.5, holder.kill).start()
-    start = time.monotonic()
-    summary = run_and_evaluate(str(directory), TrialSettings(iterations=20), eval_placements=1)
-    waited = time.monotonic() - start
-    assert summary["evaluated_at_iteration"] == 20
-    assert waited >= 1.0  # it did not write while the other process held the directory
+    results = []
+    task = threading.Thread(
+        target=lambda: results.append(
+            run_and_evaluate(str(directory), TrialSettings(iterations=20), eval_placements=1)
+        )
+    )
+    task.start()
+    task.join(timeout=2.0)  # long enough for the task to run, had it not waited
+    assert task.is_alive() and not (directory / CONFIG_FILE).exists()  # waiting, writing nothing
+    holder.kill()
+    task.join()
+    assert results and results[0]["evaluated_at_iteration"] == 20
 
 
 def test_evaluation_is_refused_while_another_process_writes(lock_holder, tmp_path):
