@@ -39,6 +39,14 @@ def client():
     cluster.close()
 
 
+def _wait_for(path: Path, polls: int = 2400) -> None:
+    """Poll (every 50 ms, at most `polls` times) until `path` exists; no clock is read."""
+    for _ in range(polls):
+        if path.exists():
+            return
+        time.sleep(0.05)
+
+
 def test_smoke_profile_runs_on_a_local_cluster_with_two_workers(tmp_path, client):
     spec = load_spec("smoke")
     assert len(client.scheduler_info()["workers"]) == 2
@@ -65,9 +73,7 @@ def test_rerun_resumes_an_unfinished_trial_from_its_checkpoint(tmp_path, client)
     args = [sys.executable, "-m", "experiments.cli", "run", "--grasp", "kinematic"]
     args += ["--iterations", "1500", "--seed", "0", "--checkpoint-every", "100", "--quiet"]
     proc = subprocess.Popen([*args, "--out", str(trial_dir)])
-    deadline = time.monotonic() + 120
-    while not (trial_dir / CHECKPOINT_FILE).exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
+    _wait_for(trial_dir / CHECKPOINT_FILE)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert not is_complete(trial_dir)
@@ -93,9 +99,7 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
         batch = pool.submit(run_batch, spec, tmp_path, client=client, progress=False)
         # Wait until a trial has checkpointed, then kill the worker running it.
         target = tmp_path / spec.trials()[0][0]
-        deadline = time.monotonic() + 120
-        while not (target / CHECKPOINT_FILE).exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
+        _wait_for(target / CHECKPOINT_FILE)
         pids = client.run(os.getpid)
         running = [a for a, keys in client.processing().items() if target.name in keys]
         assert len(running) == 1, client.processing()
