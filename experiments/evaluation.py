@@ -203,6 +203,7 @@ def evaluate_trial(
     except DirectoryLocked as exc:
         raise TrialLocked(str(exc)) from None
     try:
+        final_state = room.get_state()  # the study's measure starts from it too
         competence = competence_table(agent, room, settings, progress=progress)
         vocal = vocal_table(meta["best_word_distance"], room.words.names)
         summary = summarise(config, competence, vocal)
@@ -211,8 +212,8 @@ def evaluate_trial(
         # The study measured in the scene learning left, carried over from test to test.
         from experiments.study_measure import StudyMeasureSettings, study_tests
 
-        _, final_agent, final_room, _ = load_trial(trial_dir)
-        study = study_tests(final_agent, final_room, StudyMeasureSettings(settings.n_placements))
+        room.set_state(final_state)
+        study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
         storage.write_table(trial_dir / COMPETENCE_FILE, competence)
         storage.write_table(trial_dir / VOCAL_FILE, vocal)
         storage.write_table(trial_dir / STUDY_TESTS_FILE, study)
