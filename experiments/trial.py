@@ -46,6 +46,7 @@ from experiments.trial_files import (  # noqa: F401 (the trial's files are read 
     restore_checkpoint,
 )
 from learner.config import LearnerConfig, learner_preset
+from learner.memory import one_blas_thread
 from models.layout import TOYS, block_slice
 from sim.config import PRESETS, WorldConfig, world_preset
 from sim.experimenter import STICK_RETURNS
@@ -290,6 +291,13 @@ class Trial:
             desc=f"{self.settings.grasp} seed {self.settings.seed}",
             dynamic_ncols=True,
         )
+        with one_blas_thread():  # the inverse queries' product (learner/memory.py)
+            self._run_to(total, bar)
+        bar.set_postfix(self.counts)
+        bar.close()
+
+    def _run_to(self, total: int, bar: tqdm) -> None:
+        """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
         rows: list[dict] = []
         word_rows: list[dict] = []
         chunk_start = self.iteration
@@ -305,8 +313,6 @@ class Trial:
                 self._write_logs(chunk_start, rows, word_rows)
                 self._save_checkpoint()
                 rows, word_rows, chunk_start = [], [], self.iteration
-        bar.set_postfix(self.counts)
-        bar.close()
 
     def _iterate(self) -> dict:
         proposal, context, feedback = self.agent.play(self.room)

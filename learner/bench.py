@@ -19,7 +19,7 @@ import numpy as np
 
 from learner.agent import Agent
 from learner.config import LearnerConfig
-from learner.memory import NearestNeighbourMemory, brute_force_nearest
+from learner.memory import NearestNeighbourMemory, brute_force_nearest, one_blas_thread
 from learner.sensorimotor_model import MODELS
 from models.world import World
 
@@ -49,10 +49,13 @@ def query_ratio(
             got, want = memory.nearest(q), brute_force_nearest(rows, q)
             assert got == want, f"dim {dim}: memory answered {got}, brute force {want}"
         memory_s, brute_s = np.inf, np.inf
-        for _ in range(repeats):  # interleaved, so a busy machine slows both alike
-            start = time.perf_counter()
-            for q in queries:
-                memory.nearest(q)
+        # Interleaved, so a busy machine slows both alike; the memory on one BLAS thread, as
+        # in a trial.
+        for _ in range(repeats):
+            with one_blas_thread():
+                start = time.perf_counter()
+                for q in queries:
+                    memory.nearest(q)
             memory_s = min(memory_s, (time.perf_counter() - start) / n_queries)
             start = time.perf_counter()
             for q in queries:
@@ -93,15 +96,8 @@ def learner_overhead(
                 rng.uniform(-1.0, 1.0, (missing, model.sensory_dim)),
             )
     times = np.empty(n_iterations)
-    for i in range(n_iterations):
-        context = world.context()
-        start = time.perf_counter()
-        proposal = agent.propose(context)
-        elapsed = time.perf_counter() - start
-        s = world.act(proposal.motor_space, proposal.m).s
-        start = time.perf_counter()
-        agent.learn(proposal, context, s)
-        times[i] = elapsed + time.perf_counter() - start
+    with one_blas_thread():  # as a trial runs
+        _time_iterations(agent, world, times)
     return {
         "n_rows": n_rows,
         "babbling": babbling,
@@ -110,3 +106,16 @@ def learner_overhead(
         "p99_s": float(np.quantile(times, 0.99)),
         "model_bytes": int(sum(model.nbytes() for model in agent.models)),
     }
+
+
+def _time_iterations(agent: Agent, world: World, times: np.ndarray) -> None:
+    """Fill `times` with the seconds of propose + learn of successive iterations."""
+    for i in range(len(times)):
+        context = world.context()
+        start = time.perf_counter()
+        proposal = agent.propose(context)
+        elapsed = time.perf_counter() - start
+        s = world.act(proposal.motor_space, proposal.m).s
+        start = time.perf_counter()
+        agent.learn(proposal, context, s)
+        times[i] = elapsed + time.perf_counter() - start

@@ -13,7 +13,7 @@ from learner import bench
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from learner.interest import InterestModel
-from learner.memory import NearestNeighbourMemory, brute_force_nearest
+from learner.memory import NearestNeighbourMemory, brute_force_nearest, one_blas_thread
 from learner.sensorimotor_model import MODELS, SensorimotorModel
 from learner.synthetic import SyntheticWorld
 from sim.config import DEFAULT_WORLD
@@ -92,6 +92,28 @@ def test_memory_state_round_trip_gives_identical_answers() -> None:
         restored.append(row)
     for q in rng.uniform(-2, 2, (50, 14)):
         assert restored.nearest(q) == memory.nearest(q) == brute_force_nearest(rows, q)
+
+
+def test_one_blas_thread_answers_alike_and_gives_the_threads_back() -> None:
+    """Trials run their queries on one BLAS thread; a notebook that runs a trial keeps its
+    own thread count afterwards."""
+    from threadpoolctl import threadpool_info
+
+    def blas_threads() -> list[int]:
+        return [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+    rng = np.random.default_rng(4)
+    rows = rng.uniform(-1, 1, (3000, 18))
+    memory = NearestNeighbourMemory(18)
+    memory.extend(rows)
+    queries = rng.uniform(-1, 1, (20, 18))
+    before = blas_threads()
+    with one_blas_thread():
+        assert set(blas_threads()) <= {1}
+        inside = [memory.nearest(q) for q in queries]
+    assert blas_threads() == before
+    assert inside == [memory.nearest(q) for q in queries]
+    assert inside == [brute_force_nearest(rows, q) for q in queries]
 
 
 def test_memory_rejects_bad_input() -> None:
