@@ -43,11 +43,21 @@ replicate: $(INSTALLED)
 	$(BIN)/playroom batch --profile replication --out $(OUT)/replication
 	$(BIN)/playroom report $(OUT)/replication
 
-## ablations: each departure from the study switched back alone (32 seeds x 80000 each)
-ablations: $(INSTALLED)
-	for f in experiments/ablations/*.json; do \
-		$(BIN)/playroom batch --config $$f --out $(OUT)/ablation-$$(basename $$f .json) || exit 1; \
+## ablations: each departure from the study switched back alone (against the replication's
+## seeds 0-31), and each study setting switched into the project preset alone (against the
+## project preset), 32 seeds x 80000 each, then both tables (`playroom ablations`)
+ABLATIONS := $(basename $(notdir $(wildcard experiments/ablations/*.json)))
+FROM_STUDY := $(filter-out project%,$(ABLATIONS))
+FROM_PROJECT := $(filter project-plus-%,$(ABLATIONS))
+ablations: replicate
+	for name in $(ABLATIONS); do \
+		$(BIN)/playroom batch --config experiments/ablations/$$name.json \
+			--out $(OUT)/ablation-$$name || exit 1; \
 	done
+	$(BIN)/playroom ablations $(OUT)/replication $(addprefix $(OUT)/ablation-,$(FROM_STUDY)) \
+		--out $(OUT)/ablations-from-study
+	$(BIN)/playroom ablations $(OUT)/ablation-project $(addprefix $(OUT)/ablation-,$(FROM_PROJECT)) \
+		--out $(OUT)/ablations-from-project
 
 ## test: lint, then the test suite (under 5 minutes on 2 cores)
 test: lint

@@ -207,6 +207,21 @@ def cmd_compare(args: argparse.Namespace) -> None:
         raise UsageError(str(exc)) from None
 
 
+def cmd_ablations(args: argparse.Namespace) -> None:
+    """Batches that change a setting or two, against a baseline batch, paired by seed."""
+    from experiments.ablation import write_ablations
+    from experiments.results import ReportError
+
+    try:
+        table = write_ablations(
+            args.baseline, args.batches, args.out, args.study_reference_commands
+        )
+    except ReportError as exc:
+        raise UsageError(str(exc)) from None
+    print(table.read_text(), end="")
+    print(f"written: {table}, {table.with_name('ablations.csv').name}, ablations.png")
+
+
 def cmd_say(args: argparse.Namespace) -> None:
     """A word as audio, from the voice parameters found to produce it."""
     from pathlib import Path
@@ -332,6 +347,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="where to write comparison.html")
     _study_reference_option(p)
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("ablations", help="batches changing a setting, against a baseline")
+    p.add_argument("baseline", help="the baseline batch directory (e.g. the replication)")
+    p.add_argument("batches", nargs="+", help="batch directories, each changing a setting")
+    p.add_argument("--out", required=True, help="where to write ablations.md/.csv/.png")
+    _study_reference_option(p)
+    p.set_defaults(func=cmd_ablations)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")

@@ -70,6 +70,11 @@ class BatchResults:
         keep = {name: table[table["group"] == group] for name, table in self._tables().items()}
         return dataclasses.replace(self, **keep, configs={group: self.configs[group]})
 
+    def with_seeds(self, seeds: set[int]) -> BatchResults:
+        """The results of the trials whose seed is in `seeds` only."""
+        keep = {n: t[t["seed"].isin(seeds)] for n, t in self._tables().items() if "seed" in t}
+        return dataclasses.replace(self, **keep)
+
     def relabel(self, mapping: dict[str, str]) -> BatchResults:
         """The same results with groups renamed (to tell two batches apart)."""
         tables = {}

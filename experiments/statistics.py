@@ -107,14 +107,26 @@ def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
     }
 
 
-def mann_whitney(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """(U of a, two-sided p); NaN when a side is empty. Infinite values (a word never
-    approached) rank above every finite one, which is what they mean."""
+def mann_whitney(
+    a: np.ndarray, b: np.ndarray, alternative: str = "two-sided"
+) -> tuple[float, float]:
+    """(U of a, p); NaN when a side is empty. Infinite values (a word never approached) rank
+    above every finite one, which is what they mean. alternative "less": a tends lower."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if len(a) == 0 or len(b) == 0:
         return math.nan, math.nan
-    result = stats.mannwhitneyu(a, b, alternative="two-sided")
+    result = stats.mannwhitneyu(a, b, alternative=alternative)
     return float(result.statistic), float(result.pvalue)
+
+
+def paired_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float, float]:
+    """(mean of a - b, 95% low, high, two-sided p of the paired t test) over pairs a[i], b[i]
+    (e.g. two configurations' results on the same seed); NaN below 2 pairs."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    mean, low, high = mean_ci(a - b)
+    if len(a) < 2 or np.all(a - b == (a - b)[0]):
+        return mean, low, high, math.nan
+    return mean, low, high, float(stats.ttest_rel(a, b).pvalue)
 
 
 def welch(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:

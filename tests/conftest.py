@@ -21,3 +21,23 @@ def trained_trial(tmp_path_factory):
 
     settings = TrialSettings(grasp="kinematic", iterations=3000, seed=0, checkpoint_every=1000)
     return run_trial(tmp_path_factory.mktemp("trained") / "trial", settings, progress=False)
+
+
+@pytest.fixture(scope="session")
+def batches(tmp_path_factory):
+    """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0
+    (300 iterations, evaluated on 3 placements). Tests only read them."""
+    from experiments.evaluation import EvaluationSettings, evaluate_trial
+    from experiments.trial import TrialSettings, run_trial
+
+    root = tmp_path_factory.mktemp("batches")
+    out = {}
+    for grasp, seeds in (("kinematic", (0, 1)), ("physical", (0,))):
+        batch = root / grasp
+        for seed in seeds:
+            trial = batch / f"{grasp}-random-seed{seed:04d}"
+            settings = TrialSettings(grasp=grasp, iterations=300, seed=seed, checkpoint_every=300)
+            run_trial(trial, settings, progress=False)
+            evaluate_trial(trial, EvaluationSettings(n_placements=3))
+        out[grasp] = batch
+    return out

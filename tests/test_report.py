@@ -20,7 +20,7 @@ import pytest
 
 from experiments import figures, paper
 from experiments.curves import curve_rows, tool_numbers
-from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
+from experiments.evaluation import EVAL_FILE
 from experiments.report import (
     COMPARISON_FILE,
     REPORT_FILE,
@@ -38,25 +38,8 @@ from experiments.statistics import (
     vocal_summary,
     welch,
 )
-from experiments.trial import TrialSettings, run_trial
 
 DATA_URI = re.compile(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"')
-
-
-@pytest.fixture(scope="session")
-def batches(tmp_path_factory) -> dict[str, Path]:
-    """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0."""
-    root = tmp_path_factory.mktemp("batches")
-    out = {}
-    for grasp, seeds in (("kinematic", (0, 1)), ("physical", (0,))):
-        batch = root / grasp
-        for seed in seeds:
-            trial = batch / f"{grasp}-random-seed{seed:04d}"
-            settings = TrialSettings(grasp=grasp, iterations=300, seed=seed, checkpoint_every=300)
-            run_trial(trial, settings, progress=False)
-            evaluate_trial(trial, EvaluationSettings(n_placements=3))
-        out[grasp] = batch
-    return out
 
 
 def _copy_batch(batches: dict[str, Path], target: Path, grasps=("kinematic",)) -> Path:

@@ -1,0 +1,163 @@
+"""Ablation tables (`playroom ablations`): rows paired by seed against a baseline, labelled by
+the settings that changed, numbers checked against the trials' own files, bad input refused
+with one line and nothing written."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from experiments.ablation import CSV_FILE, FIGURE_FILE, TABLE_FILE, ablation_rows, write_ablations
+from experiments.evaluation import EvaluationSettings, evaluate_trial
+from experiments.results import ReportError
+from experiments.statistics import paired_difference
+from experiments.storage import config_differences
+from experiments.trial import TrialSettings, run_trial
+
+COMMANDS = 20  # random commands per ring behind the study's measure: enough to compute it
+
+
+@pytest.fixture(scope="module")
+def sigma_batch(tmp_path_factory) -> Path:
+    """The kinematic batch's seeds 0 and 1 again, with the exploration noise halved."""
+    batch = tmp_path_factory.mktemp("ablation") / "sigma"
+    for seed in (0, 1):
+        trial = batch / f"kinematic-random-seed{seed:04d}"
+        settings = TrialSettings(
+            grasp="kinematic",
+            iterations=300,
+            seed=seed,
+            checkpoint_every=300,
+            overrides={"learner": {"exploration_sigma": 0.05}},
+        )
+        run_trial(trial, settings, progress=False)
+        evaluate_trial(trial, EvaluationSettings(n_placements=3))
+    return batch
+
+
+def _competence(batch: Path) -> dict[int, float]:
+    """competence_all per seed, read from the trials' eval.json."""
+    out = {}
+    for trial in batch.glob("*-seed*"):
+        seed = json.loads((trial / "config.json").read_text())["trial"]["seed"]
+        out[seed] = json.loads((trial / "eval.json").read_text())["competence"]["all"]
+    return out
+
+
+def test_rows_are_paired_by_seed_and_named_by_the_changed_setting(batches, sigma_batch, tmp_path):
+    base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
+    rows = ablation_rows(batches["kinematic"], [sigma_batch], COMMANDS)
+    assert [row.label for row in rows] == [
+        "baseline (kinematic)",
+        "learner.exploration_sigma: 0.1 -> 0.05",
+    ]
+    baseline, row = rows
+    assert baseline.n_trials == row.n_trials == row.n_pairs == 2
+    assert math.isnan(baseline.difference)
+    differences = [ablated[s] - base[s] for s in (0, 1)]
+    assert row.difference == pytest.approx(np.mean(differences))
+    assert row.competence == pytest.approx(np.mean(list(ablated.values())))
+    vocal = pd.concat(pd.read_parquet(t / "vocal.parquet") for t in sigma_batch.glob("*-seed*"))
+    assert row.words_within == pytest.approx((vocal["best_distance"] < 0.4).mean())
+    names = vocal.loc[vocal["is_name"], "best_distance"]
+    assert row.median_names == pytest.approx(np.median(names))
+    assert 0.0 <= row.study_competence <= 1.0
+    assert set(row.study_strategies) == {"centre", "between_limits", "distance_1"}
+
+
+def test_the_baseline_keeps_only_the_seeds_the_ablations_hold(batches, sigma_batch, tmp_path):
+    one_seed = tmp_path / "seed1"
+    shutil.copytree(sigma_batch / "kinematic-random-seed0001", one_seed / "k-seed0001")
+    baseline, row = ablation_rows(batches["kinematic"], [one_seed], COMMANDS)
+    assert baseline.n_trials == row.n_trials == row.n_pairs == 1
+    base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
+    assert baseline.competence == pytest.approx(base[1])
+    assert row.difference == pytest.approx(ablated[1] - base[1])
+    assert math.isnan(row.difference_p)  # one pair: no test
+
+
+def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
+    table = write_ablations(batches["kinematic"], [sigma_batch], tmp_path / "out", COMMANDS)
+    assert table.name == TABLE_FILE
+    lines = table.read_text().splitlines()
+    assert len(lines) == 4 and "learner.exploration_sigma: 0.1 -> 0.05" in lines[3]
+    csv = pd.read_csv(tmp_path / "out" / CSV_FILE)
+    assert list(csv["n_trials"]) == [2, 2]
+    assert {"difference", "difference_p", "study_distance_1_vocal"} <= set(csv.columns)
+    assert (tmp_path / "out" / FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
+
+
+def test_batches_that_cannot_be_paired_are_refused_and_nothing_is_written(batches, tmp_path):
+    out = tmp_path / "out"
+    with pytest.raises(ReportError, match="none in common"):
+        write_ablations(batches["kinematic"], [batches["physical"]], out, COMMANDS)
+    other_seed = tmp_path / "seed7"
+    trial = other_seed / "kinematic-random-seed0007"
+    run_trial(trial, TrialSettings(iterations=200, seed=7, checkpoint_every=200), progress=False)
+    evaluate_trial(trial, EvaluationSettings(n_placements=3))
+    with pytest.raises(ReportError, match="shares no seed"):
+        write_ablations(batches["kinematic"], [other_seed], out, COMMANDS)
+    with pytest.raises(ReportError, match="at least one batch"):
+        write_ablations(batches["kinematic"], [], out, COMMANDS)
+    assert not out.exists()
+
+
+def test_paired_difference_is_the_one_sample_test_of_the_differences():
+    a, b = np.array([1.0, 2.0, 3.0, 5.0]), np.array([0.0, 2.0, 1.0, 1.0])
+    mean, low, high, p = paired_difference(a, b)
+    d = a - b
+    half = stats.t.ppf(0.975, 3) * d.std(ddof=1) / 2.0
+    assert mean == 1.75
+    assert (low, high) == pytest.approx((1.75 - half, 1.75 + half))
+    assert p == pytest.approx(stats.ttest_1samp(d, 0.0).pvalue)
+    assert math.isnan(paired_difference(a, a + 1.0)[3])  # no variance: no test
+
+
+def test_the_command_prints_the_table_and_names_a_bad_batch(batches, sigma_batch, tmp_path, capsys):
+    from experiments.cli import main
+
+    args = [str(batches["kinematic"]), str(sigma_batch), "--out", str(tmp_path / "out")]
+    assert main(["ablations", *args, "--study-reference-commands", str(COMMANDS)]) == 0
+    printed = capsys.readouterr().out
+    assert "learner.exploration_sigma: 0.1 -> 0.05" in printed and "ablations.png" in printed
+    missing = tmp_path / "missing"
+    assert main(["ablations", str(batches["kinematic"]), str(missing), "--out", "x"]) == 2
+    assert str(missing) in capsys.readouterr().err
+
+
+def test_each_ablation_config_changes_one_setting_of_its_preset():
+    """The shipped ablations: `NAME.json` switches one study setting back to the project's,
+    `project-plus-NAME.json` switches the same setting of the project preset to the study's,
+    `project.json` is the project preset's baseline; all on the replication's first seeds."""
+    from experiments.batch import load_spec
+    from experiments.trial import full_config
+
+    folder = Path(__file__).parent.parent / "experiments" / "ablations"
+    files = sorted(folder.glob("*.json"))
+    names = {f.stem for f in files}
+    assert {f"project-plus-{n}" for n in names if not n.startswith("project")} <= names
+    for path in files:
+        spec = load_spec(config_file=path)
+        assert spec.seeds == tuple(range(32)) and spec.iterations == 80000
+        (name, settings), *_ = spec.trials()
+        preset = dataclasses.replace(settings, overrides={})
+        changes = config_differences(full_config(preset), full_config(settings))
+        changes = [c for c in changes if not c[0].startswith("trial.overrides")]
+        if path.stem == "project":
+            assert settings.preset == "project" and changes == []
+            continue
+        assert settings.preset == ("project" if path.stem.startswith("project") else "study")
+        assert len(changes) == 1, f"{path.name} changes {changes}"
+        key, _, value = changes[0]
+        other = "study" if settings.preset == "project" else "project"
+        other_config = full_config(dataclasses.replace(settings, preset=other, overrides={}))
+        section, field = key.split(".")
+        assert other_config[section][field] == value, f"{path.name}: not the {other}'s value"
