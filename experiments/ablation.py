@@ -268,11 +268,11 @@ def write_ablations(
     baseline_dir: str | os.PathLike,
     batch_dirs: list[str | os.PathLike],
     out_dir: str | os.PathLike,
-    commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
+    study_reference_commands: int = RANDOM_COMMANDS_PER_RING,
 ) -> Path:
     """Compute the rows, then write the table, the CSV and the figure into out_dir (each
     atomically, after everything was computed). Returns the table's path."""
-    rows = ablation_rows(baseline_dir, batch_dirs, commands_per_ring)
+    rows = ablation_rows(baseline_dir, batch_dirs, study_reference_commands)
     table = markdown_table(rows)
     figure = png_bytes(ablation_figure(rows))
     csv = csv_table(rows).to_csv(index=False)

@@ -185,7 +185,7 @@ def cmd_report(args: argparse.Namespace) -> None:
     from experiments.report import ReportError, write_report
 
     try:
-        print(write_report(args.dir, args.out, args.study_reference_commands))
+        print(write_report(args.dir, args.out, **_study_reference(args)))
     except ReportError as exc:
         raise UsageError(str(exc)) from None
 
@@ -200,7 +200,7 @@ def cmd_compare(args: argparse.Namespace) -> None:
                 args.dir_a,
                 args.dir_b,
                 args.out,
-                study_reference_commands=args.study_reference_commands,
+                **_study_reference(args),
             )
         )
     except ReportError as exc:
@@ -213,9 +213,7 @@ def cmd_ablations(args: argparse.Namespace) -> None:
     from experiments.results import ReportError
 
     try:
-        table = write_ablations(
-            args.baseline, args.batches, args.out, args.study_reference_commands
-        )
+        table = write_ablations(args.baseline, args.batches, args.out, **_study_reference(args))
     except ReportError as exc:
         raise UsageError(str(exc)) from None
     print(table.read_text(), end="")
@@ -278,10 +276,16 @@ def _study_reference_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--study-reference-commands",
         type=_positive_int,
-        default=10000,
         metavar="N",
-        help="random commands per ring behind the study's own measure (the study's: 10000)",
+        help="random commands per ring behind the study's own measure (default: the study's, "
+        "10000 placements x 3 toys)",
     )
+
+
+def _study_reference(args: argparse.Namespace) -> dict:
+    """The reference size asked for, if any: the default lives in experiments.study_measure."""
+    n = args.study_reference_commands
+    return {} if n is None else {"study_reference_commands": n}
 
 
 def build_parser() -> argparse.ArgumentParser:

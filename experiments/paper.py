@@ -19,6 +19,7 @@ from typing import Any
 from experiments.report_html import Table, ci_text, num, p_value, pct, shares_text
 from experiments.results import BatchResults, Geometry
 from experiments.statistics import DISTANCE_ONE
+from experiments.study_measure import RANDOM_COMMANDS_PER_RING
 
 PAPER_FILE = "paper.json"
 # A number the paper does not give (per ring competence): said so, not left blank.
@@ -162,9 +163,12 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         return text
 
     label = "as the study computed it"
+    commands = next(iter(study.values()))["reference_commands_per_ring"]
     return [
         [
-            f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random))",
+            f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
+            f"random reference of {commands} commands per ring, the study's "
+            f"{RANDOM_COMMANDS_PER_RING})",
             paper["competence_all"].text,
             *[of(x, lambda n: pct(n["competence"]["all"])) for x in groups],
         ],
@@ -174,17 +178,17 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
             for r in (1, 2, 3)
         ],
         [
-            f"Strategy hand / tool / vocal, centre (d < 0.6), {label}",
+            f"Strategy hand / tool / vocal, centre (Fig. 4's curve, x < 0.6), {label}",
             paper["strategy_centre"].text,
             *[of(x, shares("centre")) for x in groups],
         ],
         [
-            f"Strategy hand / tool / vocal, between the limits (0.6 ≤ d < 0.85), {label}",
+            f"Strategy hand / tool / vocal, between the limits (0.6 ≤ x < 0.85), {label}",
             paper["strategy_between_limits"].text,
             *[of(x, shares("between_limits")) for x in groups],
         ],
         [
-            f"Strategy hand / tool / vocal, distance 1 (0.98 ≤ d < 1), {label}",
+            f"Strategy hand / tool / vocal, distance 1 (the curve's last bin), {label}",
             paper["strategy_distance_1"].text,
             *[of(x, shares("distance_1")) for x in groups],
         ],

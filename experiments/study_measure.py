@@ -10,12 +10,24 @@ How the study's code measured (its scripts/run.py and analysis notebooks):
   goes to the voice); when the voice model had data, the arm model's inverse was queried with
   the voice model's context values (toy, caregiver) in place of its own (stick, toy);
 - a test used the tool when the stick's x moved between the first and the last sample;
-- random reference: 10000 random commands per ring (arm or voice, 1/2 each), whose error was
-  read on toy 1's trajectory whatever the goal toy;
-- map: errors on a 100 x 100 grid over [-1, 1]^2 by the toy's position, the reference averaged
-  over one-pixel rings around the base, and per pixel max(0, 1 - agent / random). How the
-  paper's "46%" averaged the pixels is not in the study's notebooks: here, the mean over every
-  pixel that holds a test.
+- placements: drawn anew in every run (the study used the global random state), so that
+  pooled over runs the tests cover the whole disk; here from the trial's own seed;
+- random reference (notebook motor_babbling): per ring, 10000 placements, one random command
+  (arm or voice, 1/2 each) per toy as goal, so 30000 commands, whose error was read on toy 1's
+  trajectory whatever the goal toy;
+- map (notebook analysis_competence): errors pooled over runs on a 100 x 100 grid over
+  [-1, 1]^2 by the toy's position (pixel i holds x in [i/50 - 1, (i+1)/50 - 1)); the reference
+  of a pixel at pixel-distance d from pixel (50, 50) is the unweighted mean of the per-pixel
+  reference means of every pixel at a distance in (d - 1, d + 1) that holds one; per pixel
+  max(0, 1 - agent / random). How the paper's "46%" averaged the pixels is not in the study's
+  notebooks: here, the mean over every pixel that holds a test (with placements drawn anew
+  per run, about the mean over the disk);
+- strategies (Fig. 4): each pixel's shares of hand, tool and vocal tests, averaged over the
+  pixels of each radial bin int(pixel-distance) < 50 (a pixel without a test counts 0), then
+  renormalised in sequence as the notebook did (the tool share divided by a sum that already
+  holds the renormalised hand share). The curve is plotted at x = bin / 49; "distance 1" is its
+  last bin, the regions "centre" and "between the limits" its bins left of 0.6 and between
+  0.6 and 0.85 on that axis, averaged (the paper read them off the curve).
 """
 
 from __future__ import annotations
@@ -29,22 +41,26 @@ import numpy as np
 import pandas as pd
 
 from experiments.evaluation import goal_trajectory, strategy_of
+from experiments.statistics import STRATEGIES
 from learner.agent import Agent
 from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
 from sim import Playroom
 
 GRID = 100  # pixels a side over [-1, 1]^2
-RANDOM_COMMANDS_PER_RING = 10000
-# The study's strategy regions (m): within the hand's reach plus its grasp distance, within the
-# stick's, and "distance 1", its last one-pixel ring.
-HAND_LIMIT, STICK_LIMIT, DISTANCE_ONE = 0.6, 0.85, (0.98, 1.0)
+CENTRE = GRID // 2  # the pixel the notebooks measured distances from
+# 10000 placements per ring, one random command per toy (notebook motor_babbling).
+RANDOM_COMMANDS_PER_RING = 30000
+# Fig. 4's radial bins (pixel-distance int(d) < 50), plotted at x = bin / 49, and its limits
+# (the hand's reach plus its grasp distance, the stick's) on that axis.
+STRATEGY_BINS = GRID // 2
+HAND_LIMIT, STICK_LIMIT = 0.6, 0.85
 
 
 @dataclass(frozen=True)
 class StudyMeasureSettings:
     n_placements: int = 100
     random_commands_per_ring: int = RANDOM_COMMANDS_PER_RING
-    seed: int = 20170001
+    seed: int = 20170001  # the trial's seed joins it: placements differ from run to run
 
 
 def _ring_placement(room: Playroom, ring: tuple[float, float], rng) -> np.ndarray:
@@ -65,7 +81,7 @@ def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
 
 def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
     """One row per test: ring, toy, x, y (the toy's position), strategy, error."""
-    rng = np.random.default_rng(settings.seed)
+    rng = np.random.default_rng([settings.seed, room.seed])
     rows = []
     for ring_number, ring in enumerate(room.config.toy_rings, start=1):
         for _ in range(settings.n_placements):
@@ -126,23 +142,72 @@ def _pixels(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     return i, j
 
 
+def _pixel_distance() -> np.ndarray:
+    """(GRID, GRID) distance of each pixel's index from (CENTRE, CENTRE), in pixels."""
+    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
+    return np.hypot(gi - CENTRE, gj - CENTRE)
+
+
+def _pixel_means(table: pd.DataFrame, column: str) -> np.ndarray:
+    """(GRID, GRID) mean of a column per pixel, NaN where no row fell."""
+    i, j = _pixels(table)
+    sums, counts = np.zeros((GRID, GRID)), np.zeros((GRID, GRID))
+    np.add.at(sums, (i, j), table[column].to_numpy(dtype=float))
+    np.add.at(counts, (i, j), 1)
+    with np.errstate(invalid="ignore"):
+        return np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
+
+
+def reference_map(reference: pd.DataFrame) -> np.ndarray:
+    """(GRID, GRID) random error of each pixel as the study averaged it: the unweighted mean of
+    the per-pixel means of every pixel whose distance lies strictly within one pixel of its
+    own, among pixels with a mean above 0; NaN where there is none."""
+    means = _pixel_means(reference, "error").ravel()
+    distance = _pixel_distance().ravel()
+    valid = means > 0  # False for NaN too
+    order = np.argsort(distance[valid], kind="stable")
+    radii, values = distance[valid][order], means[valid][order]
+    cumulative = np.concatenate(([0.0], np.cumsum(values)))
+    low = np.searchsorted(radii, distance - 1.0, side="right")
+    high = np.searchsorted(radii, distance + 1.0, side="left")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        averaged = (cumulative[high] - cumulative[low]) / (high - low)
+    return np.where(high > low, averaged, np.nan).reshape(GRID, GRID)
+
+
 def competence_map(tests: pd.DataFrame, reference: pd.DataFrame) -> np.ndarray:
     """(GRID, GRID) per-pixel competence max(0, 1 - agent error / random error), NaN where no
-    test fell; the random error of a pixel is the mean over its one-pixel ring."""
-    i, j = _pixels(tests)
-    sums, counts = np.zeros((GRID, GRID)), np.zeros((GRID, GRID))
-    np.add.at(sums, (i, j), tests["error"].to_numpy())
-    np.add.at(counts, (i, j), 1)
-    ri, rj = _pixels(reference)
-    ring_of = np.rint(np.hypot(ri - GRID / 2, rj - GRID / 2)).astype(int)
-    ring_sum = np.bincount(ring_of, weights=reference["error"].to_numpy(), minlength=GRID)
-    ring_count = np.bincount(ring_of, minlength=GRID)
-    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
-    pixel_ring = np.rint(np.hypot(gi - GRID / 2, gj - GRID / 2)).astype(int)
+    test fell or no reference exists (the study drew those pixels grey)."""
+    agent_error = _pixel_means(tests, "error")
     with np.errstate(invalid="ignore", divide="ignore"):
-        random_error = (ring_sum / ring_count)[np.minimum(pixel_ring, len(ring_sum) - 1)]
-        agent_error = sums / counts
-        return np.where(counts > 0, np.maximum(0.0, 1.0 - agent_error / random_error), np.nan)
+        return np.maximum(0.0, 1.0 - agent_error / reference_map(reference))
+
+
+def strategy_curve(tests: pd.DataFrame) -> pd.DataFrame:
+    """Fig. 4 as the study's notebook computed it: per radial bin (rows 0..49, column `x` =
+    bin / 49 where it was plotted), the shares of hand, tool and vocal."""
+    i, j = _pixels(tests)
+    counts = {}
+    for strategy in STRATEGIES:
+        counts[strategy] = np.zeros((GRID, GRID))
+        mine = tests["strategy"].to_numpy() == strategy
+        np.add.at(counts[strategy], (i[mine], j[mine]), 1)
+    total = sum(counts.values())
+    bins = _pixel_distance().astype(int)  # int() of a non-negative distance: its floor
+    inside = bins < STRATEGY_BINS
+    pixels_per_bin = np.bincount(bins[inside], minlength=STRATEGY_BINS)
+    curve = {}
+    for strategy in STRATEGIES:
+        share = np.divide(counts[strategy], total, out=np.zeros((GRID, GRID)), where=total > 0)
+        summed = np.bincount(bins[inside], weights=share[inside], minlength=STRATEGY_BINS)
+        curve[strategy] = summed / pixels_per_bin
+    # The notebook renormalised in place, one share after the other.
+    for strategy in STRATEGIES:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            curve[strategy] = curve[strategy] / sum(curve[s] for s in STRATEGIES)
+    table = pd.DataFrame(curve)
+    table.insert(0, "x", np.arange(STRATEGY_BINS) / (STRATEGY_BINS - 1))
+    return table
 
 
 def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
@@ -151,14 +216,14 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     summary = {"competence": {"all": float(np.nanmean(competence_map(tests, reference)))}}
     for ring, table in tests.groupby("ring"):
         summary["competence"][f"ring{ring}"] = float(np.nanmean(competence_map(table, reference)))
-    distance = np.hypot(tests["x"], tests["y"])
+    curve = strategy_curve(tests)
     regions = {
-        "centre": distance < HAND_LIMIT,
-        "between_limits": (distance >= HAND_LIMIT) & (distance < STICK_LIMIT),
-        "distance_1": (distance >= DISTANCE_ONE[0]) & (distance < DISTANCE_ONE[1]),
+        "centre": curve["x"] < HAND_LIMIT,
+        "between_limits": (curve["x"] >= HAND_LIMIT) & (curve["x"] < STICK_LIMIT),
+        "distance_1": curve.index == STRATEGY_BINS - 1,
     }
     summary["strategy_share"] = {
-        name: tests.loc[mask, "strategy"].value_counts(normalize=True).to_dict()
+        name: {s: float(curve.loc[mask, s].mean()) for s in STRATEGIES}
         for name, mask in regions.items()
     }
     return summary
@@ -203,4 +268,5 @@ def study_numbers(
                 cached.parent.mkdir(parents=True, exist_ok=True)
                 storage.write_table(cached, reference)
         numbers[group] = study_summary(tests, reference)
+        numbers[group]["reference_commands_per_ring"] = commands_per_ring
     return numbers

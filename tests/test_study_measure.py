@@ -12,22 +12,85 @@ from experiments.study_measure import (
     _arm_context_of_the_study,
     competence_map,
     random_reference,
+    reference_map,
+    strategy_curve,
     study_summary,
     study_tests,
 )
 from experiments.trial import load_trial
 
 
-def test_the_map_normalises_each_pixel_by_the_random_error_of_its_ring():
-    # Two tests in one pixel (errors 0.2 and 0.4), one in another (error 3.0); the random
-    # reference has error 1.0 at the first pixel's distance and 2.0 at the second's.
+def test_the_map_normalises_each_pixel_by_the_random_error_around_its_distance():
+    # Two tests in one pixel (errors 0.2 and 0.4), one in another (error 3.0). The reference
+    # holds one command in a pixel at the first one's distance (error 1.0), two in one pixel
+    # at the second's (errors 1.0 and 3.0: that pixel's mean is 2.0).
     tests = pd.DataFrame({"x": [0.3, 0.3, -0.7], "y": [0.0, 0.0, 0.0], "error": [0.2, 0.4, 3.0]})
-    reference = pd.DataFrame({"x": [0.0, -0.3, 0.7], "y": [0.3, 0.0, 0.0], "error": [1, 1, 2.0]})
+    reference = pd.DataFrame({"x": [0.0, 0.7, 0.7], "y": [0.3, 0.0, 0.0], "error": [1.0, 1.0, 3.0]})
     grid = competence_map(tests, reference)
     i = int((0.3 + 1) / 2 * GRID)
     assert grid[i, GRID // 2] == pytest.approx(1 - 0.3 / 1.0)
     assert grid[int((-0.7 + 1) / 2 * GRID), GRID // 2] == 0.0  # worse than random: clipped at 0
     assert np.isnan(grid).sum() == GRID * GRID - 2
+
+
+def test_the_reference_is_the_mean_of_pixel_means_within_one_pixel_of_distance():
+    """The notebook's rule, written as it reads: for a pixel at distance d from (50, 50), the
+    unweighted mean of the per-pixel means above 0 of the pixels at distances in (d-1, d+1)."""
+    rng = np.random.default_rng(3)
+    reference = pd.DataFrame(
+        {
+            "x": rng.uniform(-1, 1, 4000),
+            "y": rng.uniform(-1, 1, 4000),
+            "error": rng.uniform(0.0, 2.0, 4000),
+        }
+    )
+    reference.loc[:100, "error"] = 0.0  # pixels whose mean is 0 are left out, as the study did
+    sums, counts = np.zeros((GRID, GRID)), np.zeros((GRID, GRID))
+    for x, y, e in reference[["x", "y", "error"]].itertuples(index=False):
+        i, j = min(int((x + 1) / 2 * 100), 99), min(int((y + 1) / 2 * 100), 99)
+        sums[i, j] += e
+        counts[i, j] += 1
+    means = np.where(counts > 0, sums / np.maximum(counts, 1), -1.0)
+    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
+    distance = np.sqrt((gi - 50) ** 2 + (gj - 50) ** 2)
+    got = reference_map(reference)
+    for i, j in rng.integers(0, GRID, (40, 2)):
+        d = distance[i, j]
+        similar = (d - 1 < distance) & (distance < d + 1) & (means > 0)
+        assert got[i, j] == pytest.approx(means[similar].mean())
+
+
+def test_the_strategy_curve_averages_pixels_then_renormalises_in_sequence():
+    # One pixel at distance 10 pixels from the centre holds a hand and a vocal test; the
+    # other pixels of that bin hold none and count 0.
+    x = (60 + 0.5) / 50 - 1  # pixel i = 60, j = 50: distance 10
+    tests = pd.DataFrame({"x": [x, x], "y": [0.01, 0.01], "strategy": ["hand", "vocal"]})
+    curve = strategy_curve(tests)
+    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
+    n = (np.sqrt((gi - 50) ** 2 + (gj - 50) ** 2).astype(int) == 10).sum()
+    hand, vocal = 0.5 / n, 0.5 / n
+    hand = hand / (hand + 0.0 + vocal)  # the notebook's order: hand first, with the old sum
+    vocal = vocal / (hand + 0.0 + vocal)  # then vocal, with the renormalised hand share
+    assert curve.loc[10, "hand"] == pytest.approx(0.5)
+    assert curve.loc[10, "vocal"] == pytest.approx(vocal) and vocal < 0.5
+    assert curve.loc[10, "tool"] == 0.0
+    assert len(curve) == 50 and curve["x"].iloc[-1] == 1.0
+    assert curve.drop(index=10)[["hand", "tool", "vocal"]].isna().all().all()  # 0 / 0
+
+
+def test_placements_are_drawn_from_each_trials_seed():
+    from learner.agent import Agent
+    from learner.config import LearnerConfig
+    from sim import Playroom
+
+    settings = StudyMeasureSettings(n_placements=2)
+
+    def positions(seed: int) -> np.ndarray:
+        tests = study_tests(Agent(LearnerConfig(), 0), Playroom("kinematic", seed=seed), settings)
+        return tests[["x", "y"]].to_numpy()
+
+    assert np.array_equal(positions(1), positions(1))
+    assert not np.array_equal(positions(1), positions(2))
 
 
 def test_the_arm_model_is_asked_with_the_voice_models_context_values():
