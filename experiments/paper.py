@@ -155,10 +155,23 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
     def of(group: str, pick) -> str:
         return pick(study[group]) if group in study else "not measured"
 
+    def interval(numbers: dict, *keys: str) -> str:
+        """ " [95% CI a, b]" of the bootstrap over runs, if the numbers have one."""
+        bounds = numbers.get("intervals")
+        for key in keys:
+            bounds = None if bounds is None else bounds.get(key)
+        return "" if bounds is None else f" [{pct(bounds[0])}, {pct(bounds[1])}]"
+
+    def competence(numbers: dict) -> str:
+        return pct(numbers["competence"]["all"]) + interval(numbers, "competence_all")
+
     def shares(region: str):
         def text(numbers: dict) -> str:
             share = numbers["strategy_share"].get(region, {})
-            return " / ".join(pct(share.get(k, 0.0)) for k in ("hand", "tool", "vocal"))
+            return " / ".join(
+                pct(share.get(k, 0.0)) + interval(numbers, "strategy_share", region, k)
+                for k in ("hand", "tool", "vocal")
+            )
 
         return text
 
@@ -168,9 +181,9 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         [
             f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
             f"random reference of {commands} commands per ring, the study's "
-            f"{RANDOM_COMMANDS_PER_RING})",
+            f"{RANDOM_COMMANDS_PER_RING}; 95% intervals over runs resampled)",
             paper["competence_all"].text,
-            *[of(x, lambda n: pct(n["competence"]["all"])) for x in groups],
+            *[of(x, competence) for x in groups],
         ],
         *[
             [f"… ring {r}, {label}", NOT_PUBLISHED]

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,17 +43,24 @@ import pandas as pd
 
 from experiments.evaluation import goal_trajectory, strategy_of
 from experiments.statistics import STRATEGIES
+from experiments.study_maps import (  # noqa: F401 (the maps are read from here too)
+    GRID,
+    bin_positions,
+    bootstrap_sums,
+    competence_map,
+    competence_of,
+    curve_of,
+    pixel_sums,
+    reference_map,
+    strategy_curve,
+)
 from learner.agent import Agent
 from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
 from sim import Playroom
 
-GRID = 100  # pixels a side over [-1, 1]^2
-CENTRE = GRID // 2  # the pixel the notebooks measured distances from
 # 10000 placements per ring, one random command per toy (notebook motor_babbling).
 RANDOM_COMMANDS_PER_RING = 30000
-# Fig. 4's radial bins (pixel-distance int(d) < 50), plotted at x = bin / 49, and its limits
-# (the hand's reach plus its grasp distance, the stick's) on that axis.
-STRATEGY_BINS = GRID // 2
+# Fig. 4's limits (the hand's reach plus its grasp distance, the stick's), on its plotted axis.
 HAND_LIMIT, STICK_LIMIT = 0.6, 0.85
 
 
@@ -135,97 +143,53 @@ def random_reference(room: Playroom, settings: StudyMeasureSettings) -> pd.DataF
     return pd.DataFrame(rows)
 
 
-def _pixels(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel indices (i, j) of the rows' x, y on the GRID x GRID map of [-1, 1]^2."""
-    i = np.clip(((table["x"].to_numpy() + 1) / 2 * GRID).astype(int), 0, GRID - 1)
-    j = np.clip(((table["y"].to_numpy() + 1) / 2 * GRID).astype(int), 0, GRID - 1)
-    return i, j
-
-
-def _pixel_distance() -> np.ndarray:
-    """(GRID, GRID) distance of each pixel's index from (CENTRE, CENTRE), in pixels."""
-    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
-    return np.hypot(gi - CENTRE, gj - CENTRE)
-
-
-def _pixel_means(table: pd.DataFrame, column: str) -> np.ndarray:
-    """(GRID, GRID) mean of a column per pixel, NaN where no row fell."""
-    i, j = _pixels(table)
-    sums, counts = np.zeros((GRID, GRID)), np.zeros((GRID, GRID))
-    np.add.at(sums, (i, j), table[column].to_numpy(dtype=float))
-    np.add.at(counts, (i, j), 1)
-    with np.errstate(invalid="ignore"):
-        return np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
-
-
-def reference_map(reference: pd.DataFrame) -> np.ndarray:
-    """(GRID, GRID) random error of each pixel as the study averaged it: the unweighted mean of
-    the per-pixel means of every pixel whose distance lies strictly within one pixel of its
-    own, among pixels with a mean above 0; NaN where there is none."""
-    means = _pixel_means(reference, "error").ravel()
-    distance = _pixel_distance().ravel()
-    valid = means > 0  # False for NaN too
-    order = np.argsort(distance[valid], kind="stable")
-    radii, values = distance[valid][order], means[valid][order]
-    cumulative = np.concatenate(([0.0], np.cumsum(values)))
-    low = np.searchsorted(radii, distance - 1.0, side="right")
-    high = np.searchsorted(radii, distance + 1.0, side="left")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        averaged = (cumulative[high] - cumulative[low]) / (high - low)
-    return np.where(high > low, averaged, np.nan).reshape(GRID, GRID)
-
-
-def competence_map(tests: pd.DataFrame, reference: pd.DataFrame) -> np.ndarray:
-    """(GRID, GRID) per-pixel competence max(0, 1 - agent error / random error), NaN where no
-    test fell or no reference exists (the study drew those pixels grey)."""
-    agent_error = _pixel_means(tests, "error")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.maximum(0.0, 1.0 - agent_error / reference_map(reference))
-
-
-def strategy_curve(tests: pd.DataFrame) -> pd.DataFrame:
-    """Fig. 4 as the study's notebook computed it: per radial bin (rows 0..49, column `x` =
-    bin / 49 where it was plotted), the shares of hand, tool and vocal."""
-    i, j = _pixels(tests)
-    counts = {}
-    for strategy in STRATEGIES:
-        counts[strategy] = np.zeros((GRID, GRID))
-        mine = tests["strategy"].to_numpy() == strategy
-        np.add.at(counts[strategy], (i[mine], j[mine]), 1)
-    total = sum(counts.values())
-    bins = _pixel_distance().astype(int)  # int() of a non-negative distance: its floor
-    inside = bins < STRATEGY_BINS
-    pixels_per_bin = np.bincount(bins[inside], minlength=STRATEGY_BINS)
-    curve = {}
-    for strategy in STRATEGIES:
-        share = np.divide(counts[strategy], total, out=np.zeros((GRID, GRID)), where=total > 0)
-        summed = np.bincount(bins[inside], weights=share[inside], minlength=STRATEGY_BINS)
-        curve[strategy] = summed / pixels_per_bin
-    # The notebook renormalised in place, one share after the other.
-    for strategy in STRATEGIES:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            curve[strategy] = curve[strategy] / sum(curve[s] for s in STRATEGIES)
-    table = pd.DataFrame(curve)
-    table.insert(0, "x", np.arange(STRATEGY_BINS) / (STRATEGY_BINS - 1))
-    return table
-
-
 def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     """The study's numbers: mean per-pixel competence (all rings and per ring) and the
-    strategy shares of its regions."""
-    summary = {"competence": {"all": float(np.nanmean(competence_map(tests, reference)))}}
-    for ring, table in tests.groupby("ring"):
-        summary["competence"][f"ring{ring}"] = float(np.nanmean(competence_map(table, reference)))
-    curve = strategy_curve(tests)
+    strategy shares of its regions, read off Fig. 4's curve; with a `trial` column, their 95%
+    percentile intervals over runs resampled with replacement ('intervals')."""
+    random_error = reference_map(reference)
+    x = bin_positions()
     regions = {
-        "centre": curve["x"] < HAND_LIMIT,
-        "between_limits": (curve["x"] >= HAND_LIMIT) & (curve["x"] < STICK_LIMIT),
-        "distance_1": curve.index == STRATEGY_BINS - 1,
+        "centre": x < HAND_LIMIT,
+        "between_limits": (x >= HAND_LIMIT) & (x < STICK_LIMIT),
+        "distance_1": np.arange(len(x)) == len(x) - 1,
     }
-    summary["strategy_share"] = {
-        name: {s: float(curve.loc[mask, s].mean()) for s in STRATEGIES}
-        for name, mask in regions.items()
+
+    def numbers(sums: dict[str, np.ndarray]) -> tuple[np.ndarray, dict]:
+        with warnings.catch_warnings():  # a region without tests is NaN, said by the table
+            warnings.simplefilter("ignore", RuntimeWarning)
+            competence = np.nanmean(competence_of(sums, random_error), axis=1)
+            curve = curve_of(sums)
+            shares = {
+                name: {s: np.nanmean(curve[s][:, mask], axis=1) for s in STRATEGIES}
+                for name, mask in regions.items()
+            }
+        return competence, shares
+
+    competence, shares = numbers(pixel_sums(tests))
+    summary = {
+        "competence": {"all": float(competence[0])},
+        "strategy_share": {
+            name: {s: float(v[0]) for s, v in by_strategy.items()}
+            for name, by_strategy in shares.items()
+        },
     }
+    for ring, table in tests.groupby("ring"):
+        ring_competence = numbers(pixel_sums(table))[0]
+        summary["competence"][f"ring{ring}"] = float(ring_competence[0])
+    samples = [numbers(sums) for sums in bootstrap_sums(tests)]
+    if samples:
+
+        def interval(values: list[np.ndarray]) -> list[float]:
+            return [float(q) for q in np.percentile(np.concatenate(values), [2.5, 97.5])]
+
+        summary["intervals"] = {
+            "competence_all": interval([c for c, _ in samples]),
+            "strategy_share": {
+                name: {s: interval([sh[name][s] for _, sh in samples]) for s in STRATEGIES}
+                for name in regions
+            },
+        }
     return summary
 
 

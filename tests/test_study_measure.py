@@ -110,3 +110,30 @@ def test_tests_and_reference_on_a_trained_trial(trained_trial):
     summary = study_summary(tests, reference)
     assert set(summary["competence"]) == {"all", "ring1", "ring2", "ring3"}
     assert 0.0 <= summary["competence"]["all"] <= 1.0
+
+
+def test_intervals_resample_runs_and_vanish_when_runs_agree():
+    rng = np.random.default_rng(5)
+    n = 600
+    one_run = pd.DataFrame(
+        {
+            "x": rng.uniform(-0.7, 0.7, n),
+            "y": rng.uniform(-0.7, 0.7, n),
+            "error": rng.uniform(0.0, 1.0, n),
+            "strategy": rng.choice(["hand", "tool", "vocal"], n),
+            "ring": rng.integers(1, 4, n),
+        }
+    )
+    reference = one_run.assign(error=1.0)
+    copies = pd.concat([one_run.assign(trial=f"t{k}") for k in range(4)], ignore_index=True)
+    summary = study_summary(copies, reference)
+    low, high = summary["intervals"]["competence_all"]
+    assert low == pytest.approx(summary["competence"]["all"]) == pytest.approx(high)
+    assert "intervals" not in study_summary(one_run.assign(trial="t0"), reference)
+    differing = copies.copy()
+    differing.loc[differing["trial"] == "t0", "error"] *= 0.5  # one run much better
+    summary = study_summary(differing, reference)
+    low, high = summary["intervals"]["competence_all"]
+    assert low < summary["competence"]["all"] < high
+    low, high = summary["intervals"]["strategy_share"]["centre"]["hand"]
+    assert 0.0 <= low <= summary["strategy_share"]["centre"]["hand"] <= high <= 1.0
