@@ -43,6 +43,7 @@ from experiments.statistics import (
     welch,
 )
 from experiments.stick import grasp_rates
+from experiments.study_figures import study_figure_files
 from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
 
 COMPARISON_FILE = "comparison.html"
@@ -266,6 +267,7 @@ def write_comparison(
     figures = [
         FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png)
         for f in report_figures(merged, geometry, published["competence_all"].value)
+        + study_figure_files(merged, published)
     ]
     g = merged.groups
     page = render(

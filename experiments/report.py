@@ -19,6 +19,7 @@ from experiments.figures import report_figures
 from experiments.report_html import render, settings_table, trials_table, write_page
 from experiments.results import Geometry, ReportError, collect
 from experiments.statistics import summarise
+from experiments.study_figures import study_figure_files
 from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
 
 # The CLI imports ReportError, write_report and write_comparison from here.
@@ -42,6 +43,7 @@ def write_report(
     numbers["study"] = study_numbers(results, study_reference_commands, results.batch_dir)
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
+    figures += study_figure_files(results, published)
     page = render(
         "report.html.j2",
         title=f"Playroom batch report: {results.batch_dir.name}",

@@ -89,6 +89,8 @@ def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     for published in ("46%", "0.23", "0.30", "88%", "1e-72", "38% / 13% / 49%"):
         assert published in text
     assert "2 trials" in text and "this batch: kinematic" in text
+    assert (out / "fig4-strategies-as-the-study-computed-it.png").exists()  # study tests held
+    assert "as the study computed it (paper Fig. 4)" in text
     assert not list(out.glob(".*.tmp"))
 
 
