@@ -22,6 +22,8 @@ from experiments.statistics import DISTANCE_ONE
 from experiments.study_measure import RANDOM_COMMANDS_PER_RING
 
 PAPER_FILE = "paper.json"
+# Below this share of the disk's pixels holding a test, the study's strategy shares are flagged.
+FULL_COVERAGE = 0.9
 # A number the paper does not give (per ring competence): said so, not left blank.
 NOT_PUBLISHED = "not published"
 
@@ -168,10 +170,16 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
     def shares(region: str):
         def text(numbers: dict) -> str:
             share = numbers["strategy_share"].get(region, {})
-            return " / ".join(
+            cells = " / ".join(
                 pct(share.get(k, 0.0)) + interval(numbers, "strategy_share", region, k)
                 for k in ("hand", "tool", "vocal")
             )
+            coverage = numbers.get("coverage", 1.0)
+            if coverage < FULL_COVERAGE:  # the notebook's renormalisation needs full coverage
+                cells += (
+                    f" (tests in only {pct(coverage)} of the disk's pixels: shares sum below 100%)"
+                )
+            return cells
 
         return text
 

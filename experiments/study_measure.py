@@ -45,11 +45,13 @@ from experiments.evaluation import goal_trajectory, strategy_of
 from experiments.statistics import STRATEGIES
 from experiments.study_maps import (  # noqa: F401 (the maps are read from here too)
     GRID,
+    STRATEGY_BINS,
     bin_positions,
     bootstrap_sums,
     competence_map,
     competence_of,
     curve_of,
+    pixel_distance,
     pixel_sums,
     reference_map,
     strategy_curve,
@@ -166,8 +168,13 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
             }
         return competence, shares
 
-    competence, shares = numbers(pixel_sums(tests))
+    pooled = pixel_sums(tests)
+    competence, shares = numbers(pooled)
+    disk = pixel_distance() < STRATEGY_BINS
     summary = {
+        # The notebook's renormalisation assumes nearly every pixel holds a test (100 runs):
+        # with few, a bin's shares sum to less than 1.
+        "coverage": float((pooled["count"][0][disk] > 0).mean()),
         "competence": {"all": float(competence[0])},
         "strategy_share": {
             name: {s: float(v[0]) for s, v in by_strategy.items()}

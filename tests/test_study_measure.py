@@ -137,3 +137,19 @@ def test_intervals_resample_runs_and_vanish_when_runs_agree():
     assert low < summary["competence"]["all"] < high
     low, high = summary["intervals"]["strategy_share"]["centre"]["hand"]
     assert 0.0 <= low <= summary["strategy_share"]["centre"]["hand"] <= high <= 1.0
+
+
+def test_coverage_counts_the_disk_pixels_holding_a_test():
+    tests = pd.DataFrame(
+        {
+            "x": [0.3, 0.3, -0.7],
+            "y": [0.0, 0.0, 0.0],
+            "error": [0.2, 0.4, 3.0],
+            "strategy": ["hand", "tool", "vocal"],
+            "ring": [1, 1, 3],
+        }
+    )
+    gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
+    disk = (np.sqrt((gi - 50) ** 2 + (gj - 50) ** 2) < 50).sum()
+    summary = study_summary(tests, tests.assign(error=1.0))
+    assert summary["coverage"] == pytest.approx(2 / disk)
