@@ -9,23 +9,13 @@ from collections import Counter
 
 import numpy as np
 
-
-class UsageError(Exception):
-    """A problem with what the user asked for: printed as one line, exit code 2."""
-
-
-def _non_negative_int(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {value}")
-    return value
+from experiments.cli_args import (
+    Parser,
+    UsageError,
+    iteration_list,
+    non_negative_int,
+    positive_int,
+)
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -125,16 +115,6 @@ def cmd_batch(args: argparse.Namespace) -> None:
         c = summary["competence"]
         print(f"  {name}: competence ring1 {c['ring1']:+.2f}, all {c['all']:+.2f}")
     print(f"{args.out}: {len(spec.trials())} trials complete")
-
-
-def _iteration_list(text: str) -> list[int]:
-    try:
-        values = [int(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected I,J,... integers, got {text!r}") from None
-    if not values:
-        raise argparse.ArgumentTypeError("no iteration given")
-    return values
 
 
 def cmd_render(args: argparse.Namespace) -> None:
@@ -265,17 +245,10 @@ def cmd_bench(args: argparse.Namespace) -> None:
     run_bench(sections)
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse, with errors on one line (exit code 2) instead of usage plus message."""
-
-    def error(self, message: str) -> None:
-        self.exit(2, f"{self.prog}: error: {message}\n")
-
-
 def _study_reference_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--study-reference-commands",
-        type=_positive_int,
+        type=positive_int,
         metavar="N",
         help="random commands per ring behind the study's own measure (default: the study's, "
         "10000 placements x 3 toys)",
@@ -289,24 +262,24 @@ def _study_reference(args: argparse.Namespace) -> dict:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = Parser(
         prog="playroom", description="A MuJoCo playroom for Model Babbling of tool use and speech."
     )
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("random", help="act random arm commands and print what happened")
     p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
-    p.add_argument("--iterations", type=_positive_int, default=20)
-    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.add_argument("--iterations", type=positive_int, default=20)
+    p.add_argument("--seed", type=non_negative_int, default=0)
     p.set_defaults(func=cmd_random)
 
     p = sub.add_parser("run", help="one trial of Model Babbling into a directory")
     p.add_argument("--grasp", choices=["kinematic", "physical"], default="kinematic")
-    p.add_argument("--iterations", type=_positive_int, default=80000)
-    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.add_argument("--iterations", type=positive_int, default=80000)
+    p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--out", required=True, help="the trial directory")
     p.add_argument("--babbling", choices=["random", "active"], default="random")
-    p.add_argument("--checkpoint-every", type=_positive_int, default=1000, metavar="K")
+    p.add_argument("--checkpoint-every", type=positive_int, default=1000, metavar="K")
     p.add_argument(
         "--stick-return",
         choices=["out_of_reach", "never"],
@@ -326,7 +299,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("eval", help="evaluate a trial: competence, strategies, vocal errors")
     p.add_argument("dir", help="a trial directory written by `playroom run`")
-    p.add_argument("--placements", type=_positive_int, default=100, help="per ring")
+    p.add_argument("--placements", type=positive_int, default=100, help="per ring")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_eval)
 
@@ -336,7 +309,7 @@ def build_parser() -> argparse.ArgumentParser:
     which.add_argument("--config", help="a JSON file of the same form as the profiles")
     p.add_argument("--out", required=True, help="the batch directory")
     p.add_argument("--scheduler", help="tcp://HOST:PORT of a running Dask scheduler")
-    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: cores)")
+    p.add_argument("--workers", type=positive_int, help="local worker processes (default: cores)")
     p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser("report", help="figures and report.html of a batch beside the paper")
@@ -363,11 +336,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")
     p.add_argument("--out", required=True, help="the MP4 file to write")
     which = p.add_mutually_exclusive_group()
-    which.add_argument("--iterations", type=_iteration_list, help="I,J,...: iterations to film")
+    which.add_argument("--iterations", type=iteration_list, help="I,J,...: iterations to film")
     which.add_argument("--highlights", action="store_true", help="first grasp, tool use, ...")
     p.add_argument("--random", action="store_true", help="random commands in a new room")
     p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
-    p.add_argument("--seed", type=_non_negative_int, default=0)
+    p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--size", default="640x480", help="WxH, even numbers")
     p.add_argument("--fps", type=float, default=50.0)
     p.add_argument("--camera", choices=["top", "hand_view"], default="top")
