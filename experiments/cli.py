@@ -100,6 +100,11 @@ def cmd_eval(args: argparse.Namespace) -> None:
         f"  words below 0.4: {v['share_below_threshold']:.0%}; median best distance: names "
         f"{v['median_names']:.2f}, distractors {v['median_distractors']:.2f}"
     )
+    # The study pooled its runs per pixel before normalising: one trial has no such number.
+    print(
+        "  the study's tests: study-tests.parquet (its measure pools trials per pixel: "
+        "`playroom report` of the batch computes it, as the study computed it)"
+    )
 
 
 def cmd_batch(args: argparse.Namespace) -> None:
