@@ -11,6 +11,7 @@ code path.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterator
 
 import numpy as np
@@ -34,10 +35,24 @@ def pixel_indices(table: pd.DataFrame) -> np.ndarray:
     return i * GRID + j
 
 
+@functools.cache
 def pixel_distance() -> np.ndarray:
-    """(GRID * GRID,) distance of each pixel's index from (CENTRE, CENTRE), in pixels."""
+    """(GRID * GRID,) distance of each pixel's index from (CENTRE, CENTRE), in pixels
+    (computed once, read-only)."""
     gi, gj = np.meshgrid(np.arange(GRID), np.arange(GRID), indexing="ij")
-    return np.hypot(gi - CENTRE, gj - CENTRE).ravel()
+    distance = np.hypot(gi - CENTRE, gj - CENTRE).ravel()
+    distance.flags.writeable = False
+    return distance
+
+
+@functools.cache
+def _bin_membership() -> np.ndarray:
+    """(GRID * GRID, STRATEGY_BINS) 1 where a pixel belongs to a radial bin of Fig. 4
+    (computed once, read-only)."""
+    bins = pixel_distance().astype(int)  # int() of a non-negative distance: its floor
+    membership = (bins[:, None] == np.arange(STRATEGY_BINS)[None, :]).astype(float)
+    membership.flags.writeable = False
+    return membership
 
 
 def pixel_sums(table: pd.DataFrame, runs: np.ndarray | None = None) -> dict[str, np.ndarray]:
@@ -93,8 +108,7 @@ def curve_of(sums: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Fig. 4's curve of pooled sums: strategy -> (samples, STRATEGY_BINS) shares. Each pixel's
     shares, averaged over the pixels of its bin (a pixel without a test counts 0), then
     renormalised in place one strategy after the other, as the notebook did."""
-    bins = pixel_distance().astype(int)  # int() of a non-negative distance: its floor
-    membership = (bins[:, None] == np.arange(STRATEGY_BINS)[None, :]).astype(float)
+    membership = _bin_membership()
     pixels_per_bin = membership.sum(axis=0)
     total = sum(sums[s] for s in STRATEGIES)
     curve = {}

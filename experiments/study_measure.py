@@ -157,10 +157,15 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
         "distance_1": np.arange(len(x)) == len(x) - 1,
     }
 
+    def mean_competence(sums: dict[str, np.ndarray]) -> np.ndarray:
+        with warnings.catch_warnings():  # no pixel with a test: NaN, said by the table
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.nanmean(competence_of(sums, random_error), axis=1)
+
     def numbers(sums: dict[str, np.ndarray]) -> tuple[np.ndarray, dict]:
+        competence = mean_competence(sums)
         with warnings.catch_warnings():  # a region without tests is NaN, said by the table
             warnings.simplefilter("ignore", RuntimeWarning)
-            competence = np.nanmean(competence_of(sums, random_error), axis=1)
             curve = curve_of(sums)
             shares = {
                 name: {s: np.nanmean(curve[s][:, mask], axis=1) for s in STRATEGIES}
@@ -182,8 +187,8 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
         },
     }
     for ring, table in tests.groupby("ring"):
-        ring_competence = numbers(pixel_sums(table))[0]
-        summary["competence"][f"ring{ring}"] = float(ring_competence[0])
+        ring_sums = pixel_sums(table[["x", "y", "error"]])
+        summary["competence"][f"ring{ring}"] = float(mean_competence(ring_sums)[0])
     samples = [numbers(sums) for sums in bootstrap_sums(tests)]
     if samples:
 
