@@ -28,7 +28,6 @@ from experiments import storage
 from experiments.lock import DirectoryLock, DirectoryLocked
 from experiments.trial import TrialLocked, load_trial
 from learner.agent import Agent
-from learner.memory import one_blas_thread
 from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
 from sim import events as ev
@@ -205,8 +204,7 @@ def evaluate_trial(
         raise TrialLocked(str(exc)) from None
     try:
         final_state = room.get_state()  # the study's measure starts from it too
-        with one_blas_thread():  # thousands of inverse queries (learner/memory.py)
-            competence = competence_table(agent, room, settings, progress=progress)
+        competence = competence_table(agent, room, settings, progress=progress)
         vocal = vocal_table(meta["best_word_distance"], room.words.names)
         summary = summarise(config, competence, vocal)
         summary["evaluated_at_iteration"] = int(meta["iteration"])
@@ -215,8 +213,7 @@ def evaluate_trial(
         from experiments.study_measure import StudyMeasureSettings, study_tests
 
         room.set_state(final_state)
-        with one_blas_thread():
-            study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
+        study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
         storage.write_table(trial_dir / COMPETENCE_FILE, competence)
         storage.write_table(trial_dir / VOCAL_FILE, vocal)
         storage.write_table(trial_dir / STUDY_TESTS_FILE, study)

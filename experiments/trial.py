@@ -46,7 +46,6 @@ from experiments.trial_files import (  # noqa: F401 (the trial's files are read 
     restore_checkpoint,
 )
 from learner.config import LearnerConfig, learner_preset
-from learner.memory import one_blas_thread
 from models.layout import TOYS, block_slice
 from sim.config import PRESETS, WorldConfig, world_preset
 from sim.experimenter import STICK_RETURNS
@@ -291,8 +290,7 @@ class Trial:
             desc=f"{self.settings.grasp} seed {self.settings.seed}",
             dynamic_ncols=True,
         )
-        with one_blas_thread():  # the inverse queries' product (learner/memory.py)
-            self._run_to(total, bar)
+        self._run_to(total, bar)
         bar.set_postfix(self.counts)
         bar.close()
 

@@ -7,33 +7,37 @@ leaves: scipy's cKDTree measured 0.2 to 2.8 times the time of a plain NumPy scan
 What this memory does instead is a scan made cheap, in two stages, with the same answer as
 `brute_force_nearest` (including which row wins a tie: the lowest index):
 
-1. Screening, float32: with h_i = |x_i|^2 / 2, the row minimising |x_i - q| also minimises
-   h_i - x_i . q, one matrix-vector product over a column-major float32 copy [x_i, h_i]
-   (rows of the copy are dimensions, so the product streams contiguous memory).
-2. Exact re-ranking, float64: every row whose screened value lies within a rigorous bound of
-   float32 rounding error of the smallest is re-ranked with the very expression of the
-   brute-force reference. Usually that is one row.
+1. Screening (learner/quantized_scan.py): every row is also kept as 8-bit codes on a grid of
+   step `scale / 127`; a compiled kernel computes the query's distance to every row's codes in
+   float32 and returns the rows that a rigorous bound of quantisation and rounding error allows
+   to be the nearest. Usually that is one row.
+2. Exact re-ranking, float64: the candidates are re-ranked with the very expression of the
+   brute-force reference.
 
-OpenBLAS runs this product on several threads when it can, which on a busy machine (a batch
-runs one trial per core) made it 4 times slower than the NumPy scan. Long loops of queries (a
-trial, an evaluation, the benchmarks) therefore run inside `one_blas_thread()`, entered once:
-switching the thread count around every query cost about 20 us of a 160 us query.
-
-Appends write one row into preallocated arrays that double when full (amortised O(dim)).
-The state for checkpoints is the float64 rows alone; the float32 copy is rebuilt from them.
+The grid's `scale` is the smallest power of two, at least 1, above every stored |value|: the
+agent's spaces lie in [-1, 1], so it is 1; a larger value re-codes every row (rarely: at most
+once per doubling). The scale follows from the rows alone, so a memory rebuilt from its
+`state_dict` answers identically. Appends write one row into preallocated arrays that double
+when full (amortised O(dim)).
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 
 import numpy as np
 from numpy.typing import ArrayLike
-from threadpoolctl import threadpool_limits
 
-_F32_UNIT_ROUNDOFF = 2.0**-24
+from learner.quantized_scan import (
+    BLOCK_ROWS,
+    CODE_MAX,
+    candidate_limit,
+    screen_candidates,
+)
+
 _INITIAL_CAPACITY = 1024
+# A query this far outside the grid (in steps) would overflow float32 sums: scanned exactly.
+_FAR_QUERY_CODES = 1e15
 
 
 def squared_distances(rows: np.ndarray, query: np.ndarray) -> np.ndarray:
@@ -60,6 +64,13 @@ def brute_force_nearest(rows: ArrayLike, query: ArrayLike) -> tuple[int, float]:
     return i, float(np.sqrt(sq[i]))
 
 
+def _scale_for(max_abs: float) -> float:
+    """The grid's scale for rows whose largest |value| is max_abs: a power of two, >= 1."""
+    if max_abs <= 1.0:
+        return 1.0
+    return 2.0 ** math.ceil(math.log2(max_abs))
+
+
 class NearestNeighbourMemory:
     """Rows of `dim` floats, appended one at a time, with exact nearest-neighbour queries."""
 
@@ -67,14 +78,9 @@ class NearestNeighbourMemory:
         if not isinstance(dim, int | np.integer) or dim <= 0:
             raise ValueError(f"memory dimension must be a positive integer, got {dim!r}")
         self._dim = int(dim)
-        capacity = max(int(capacity), 1)
         self._n = 0
-        self._rows = np.empty((capacity, self._dim))  # float64, what the answers are made of
-        # Screening copy, one column per row: dims 0..dim-1 = x (float32), dim = |x|^2 / 2.
-        self._screen = np.empty((self._dim + 1, capacity), dtype=np.float32)
-        self._max_sq_norm = 0.0  # of any row, for the float32 error bound
-        self._scratch = np.empty(0, dtype=np.float32)  # screened values of a query
-        self._below = np.empty(0, dtype=bool)  # rows within the error bound of the best
+        self._scale = 1.0  # grid step is scale / CODE_MAX
+        self._allocate(max(int(capacity), 1))
 
     @property
     def dim(self) -> int:
@@ -103,11 +109,12 @@ class NearestNeighbourMemory:
             self._reserve(self._n + 1)
         n = self._n
         self._rows[n] = row
-        sq_norm = float(row @ row)
-        self._screen[: self._dim, n] = row
-        self._screen[self._dim, n] = 0.5 * sq_norm
-        self._max_sq_norm = max(self._max_sq_norm, sq_norm)
         self._n = n + 1
+        max_abs = float(np.abs(row).max())
+        if max_abs > self._scale:
+            self._recode(max_abs)
+        else:
+            self._codes[:, n] = np.rint(row * (CODE_MAX / self._scale))
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""
@@ -122,11 +129,12 @@ class NearestNeighbourMemory:
         self._reserve(self._n + k)
         n = self._n
         self._rows[n : n + k] = rows
-        sq_norms = np.einsum("ij,ij->i", rows, rows)
-        self._screen[: self._dim, n : n + k] = rows.T
-        self._screen[self._dim, n : n + k] = 0.5 * sq_norms
-        self._max_sq_norm = max(self._max_sq_norm, float(sq_norms.max()))
         self._n = n + k
+        max_abs = float(np.abs(rows).max())
+        if max_abs > self._scale:
+            self._recode(max_abs)
+        else:
+            self._codes[:, n : n + k] = np.rint(rows.T * (CODE_MAX / self._scale))
 
     def nearest(self, query: ArrayLike) -> tuple[int, float]:
         """(index of the nearest row, Euclidean distance), as `brute_force_nearest` answers.
@@ -141,27 +149,25 @@ class NearestNeighbourMemory:
         n = self._n
         if n == 0:
             raise ValueError("nearest neighbour asked of an empty memory")
-        q_aug = np.empty(self._dim + 1, dtype=np.float32)
-        q_aug[: self._dim] = -q
-        q_aug[self._dim] = 1.0
-        # Scratch buffers are reused: a fresh (n,) array per query costs page faults.
-        if self._scratch.shape[0] < n:
-            self._scratch = np.empty(self._rows.shape[0], dtype=np.float32)
-            self._below = np.empty(self._rows.shape[0], dtype=bool)
-        screened = self._scratch[:n]
-        np.matmul(q_aug, self._screen[:, :n], out=screened)  # h_i - x_i . q, float32
-        best = int(np.argmin(screened))
-        # Rounding of the inputs to float32 and of a (dim + 1)-term float32 dot product moves
-        # a screened value by at most (dim + 4) u (h + |x| |q|); twice that, for safety, on
-        # each side of the comparison.
-        err = 2.0 * (self._dim + 4) * _F32_UNIT_ROUNDOFF
-        err *= 0.5 * self._max_sq_norm + math.sqrt(self._max_sq_norm) * math.sqrt(q @ q)
-        below = np.less_equal(screened, screened[best] + 2.0 * err, out=self._below[:n])
-        # Usually the best row is alone within the bound: counting is one fast pass, and the
-        # candidates' indices are gathered only when there are several.
-        if np.count_nonzero(below) == 1:
+        q_codes = q * (CODE_MAX / self._scale)
+        if not np.abs(q_codes).max() < _FAR_QUERY_CODES:
+            return brute_force_nearest(self._rows[:n], q)
+        eta, rho = candidate_limit(self._dim, math.sqrt(q_codes @ q_codes))
+        count = screen_candidates(
+            self._codes,
+            n,
+            q_codes.astype(np.float32),
+            eta,
+            rho,
+            self._squared,
+            self._block_min,
+            self._candidates,
+        )
+        if count == 1:
+            best = int(self._candidates[0])
             return best, float(np.sqrt(squared_distances(self._rows[best : best + 1], q)[0]))
-        candidates = np.flatnonzero(below)
+        # In increasing index order, so argmin's first minimum is the lowest index of a tie.
+        candidates = self._candidates[:count]
         sq = squared_distances(self._rows[candidates], q)
         j = int(np.argmin(sq))
         return int(candidates[j]), float(np.sqrt(sq[j]))
@@ -178,14 +184,23 @@ class NearestNeighbourMemory:
                 f"memory state rows must have shape (n, {self._dim}), got {rows.shape}"
             )
         self._n = 0
-        self._max_sq_norm = 0.0
-        self._rows = np.empty((_INITIAL_CAPACITY, self._dim))
-        self._screen = np.empty((self._dim + 1, _INITIAL_CAPACITY), dtype=np.float32)
+        self._scale = 1.0
+        self._allocate(_INITIAL_CAPACITY)
         self.extend(rows)
 
     def nbytes(self) -> int:
         """Bytes held by the preallocated arrays."""
-        return self._rows.nbytes + self._screen.nbytes
+        arrays = (self._rows, self._codes, self._squared, self._block_min, self._candidates)
+        return sum(a.nbytes for a in arrays)
+
+    def _allocate(self, capacity: int) -> None:
+        """Empty arrays for `capacity` rows (the first `self._n` are copied by the caller)."""
+        self._rows = np.empty((capacity, self._dim))  # float64, what the answers are made of
+        # Codes one column per row: the kernel streams each dimension's codes contiguously.
+        self._codes = np.zeros((self._dim, capacity), dtype=np.int8)
+        self._squared = np.empty(capacity, dtype=np.float32)  # the kernel's scratch
+        self._block_min = np.empty(capacity // BLOCK_ROWS + 1, dtype=np.float32)
+        self._candidates = np.empty(capacity, dtype=np.intp)
 
     def _reserve(self, n_rows: int) -> None:
         """Make room for n_rows, doubling the capacity as often as needed."""
@@ -194,13 +209,13 @@ class NearestNeighbourMemory:
             return
         while capacity < n_rows:
             capacity *= 2
-        rows = np.empty((capacity, self._dim))
-        screen = np.empty((self._dim + 1, capacity), dtype=np.float32)
-        rows[: self._n] = self._rows[: self._n]
-        screen[:, : self._n] = self._screen[:, : self._n]
-        self._rows, self._screen = rows, screen
+        rows, codes = self._rows[: self._n], self._codes[:, : self._n]
+        self._allocate(capacity)
+        self._rows[: self._n] = rows
+        self._codes[:, : self._n] = codes
 
-
-def one_blas_thread() -> contextlib.AbstractContextManager:
-    """Run the block with every BLAS library on one thread; the counts are restored after."""
-    return threadpool_limits(limits=1, user_api="blas")
+    def _recode(self, max_abs: float) -> None:
+        """Widen the grid to hold |value| up to max_abs and re-code every stored row."""
+        self._scale = max(self._scale, _scale_for(max_abs))
+        n = self._n
+        self._codes[:, :n] = np.rint(self._rows[:n].T * (CODE_MAX / self._scale))

@@ -13,7 +13,6 @@ from learner import bench
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from learner.interest import InterestModel
-from learner.memory import NearestNeighbourMemory, brute_force_nearest, one_blas_thread
 from learner.sensorimotor_model import MODELS, SensorimotorModel
 from learner.synthetic import SyntheticWorld
 from sim.config import DEFAULT_WORLD
@@ -43,92 +42,6 @@ def _savez_round_trip(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 
 def _run(agent: Agent, world: SyntheticWorld, n: int) -> list[Proposal]:
     return [agent.play(world)[0] for _ in range(n)]
-
-
-# ---------------------------------------------------------------- memory
-
-
-@pytest.mark.parametrize("dim", [1, 10, 18, 38])
-def test_memory_matches_brute_force_as_it_grows(dim: int) -> None:
-    rng = np.random.default_rng(dim)
-    rows = rng.uniform(-1, 1, (2100, dim))
-    memory = NearestNeighbourMemory(dim, capacity=4)
-    checkpoints = {1, 2, 3, 4, 5, 1023, 1024, 1025, 2048, 2049, 2100}
-    for n, row in enumerate(rows, start=1):
-        memory.append(row)
-        if n in checkpoints:
-            far = rng.uniform(-3, 3, (10, dim))
-            near = rows[rng.integers(0, n, 10)] + rng.normal(0, 1e-3, (10, dim))
-            for q in np.vstack((far, near)):
-                assert memory.nearest(q) == brute_force_nearest(rows[:n], q)
-    assert len(memory) == 2100
-    np.testing.assert_array_equal(memory.rows, rows)
-
-
-def test_memory_ties_and_near_ties_follow_brute_force() -> None:
-    rng = np.random.default_rng(0)
-    base = rng.uniform(-1, 1, (300, 12)) + 50.0  # large norms stress the float32 screening
-    # Exact duplicates (tie -> lowest index) and rows 1e-9 apart (below float32 resolution).
-    rows = np.vstack((base, base[::-1], base + 1e-9, base - 1e-9))
-    memory = NearestNeighbourMemory(12)
-    memory.extend(rows[:500])
-    for row in rows[500:]:
-        memory.append(row)
-    queries = np.vstack((base[:50] + rng.normal(0, 1e-6, (50, 12)), base[50:100]))
-    for q in queries:
-        assert memory.nearest(q) == brute_force_nearest(rows, q)
-
-
-def test_memory_state_round_trip_gives_identical_answers() -> None:
-    rng = np.random.default_rng(1)
-    rows = rng.uniform(-1, 1, (1500, 14))
-    memory = NearestNeighbourMemory(14)
-    for row in rows[:1000]:
-        memory.append(row)
-    restored = NearestNeighbourMemory(14)
-    restored.load_state_dict(_savez_round_trip(memory.state_dict()))
-    for row in rows[1000:]:  # both keep growing after the restore
-        memory.append(row)
-        restored.append(row)
-    for q in rng.uniform(-2, 2, (50, 14)):
-        assert restored.nearest(q) == memory.nearest(q) == brute_force_nearest(rows, q)
-
-
-def test_one_blas_thread_answers_alike_and_gives_the_threads_back() -> None:
-    """Trials run their queries on one BLAS thread; a notebook that runs a trial keeps its
-    own thread count afterwards."""
-    from threadpoolctl import threadpool_info
-
-    def blas_threads() -> list[int]:
-        return [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
-
-    rng = np.random.default_rng(4)
-    rows = rng.uniform(-1, 1, (3000, 18))
-    memory = NearestNeighbourMemory(18)
-    memory.extend(rows)
-    queries = rng.uniform(-1, 1, (20, 18))
-    before = blas_threads()
-    with one_blas_thread():
-        assert set(blas_threads()) <= {1}
-        inside = [memory.nearest(q) for q in queries]
-    assert blas_threads() == before
-    assert inside == [memory.nearest(q) for q in queries]
-    assert inside == [brute_force_nearest(rows, q) for q in queries]
-
-
-def test_memory_rejects_bad_input() -> None:
-    memory = NearestNeighbourMemory(3)
-    with pytest.raises(ValueError, match="empty"):
-        memory.nearest(np.zeros(3))
-    with pytest.raises(ValueError, match="shape"):
-        memory.append(np.zeros(4))
-    with pytest.raises(ValueError, match="NaN"):
-        memory.append(np.array([0.0, np.nan, 0.0]))
-    memory.append(np.zeros(3))
-    with pytest.raises(ValueError, match="NaN"):
-        memory.nearest(np.array([np.inf, 0.0, 0.0]))
-    with pytest.raises(ValueError, match="positive"):
-        NearestNeighbourMemory(0)
 
 
 # ---------------------------------------------------------------- the 10 models
