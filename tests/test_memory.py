@@ -117,3 +117,16 @@ def test_memory_rejects_bad_input() -> None:
     with pytest.raises(ValueError, match="positive"):
         NearestNeighbourMemory(0)
     assert len(memory) == 1  # refused rows were not stored
+
+
+def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
+    """`playroom bench` times the kernel's load apart from the trials: that holds only if the
+    warm-up compiles the very specialisation a memory's query calls."""
+    from learner.quantized_scan import screen_candidates, warm_up
+
+    warm_up()
+    loaded = set(screen_candidates.signatures)
+    memory = NearestNeighbourMemory(14)
+    memory.extend(np.random.default_rng(5).uniform(-1, 1, (100, 14)))
+    memory.nearest(np.zeros(14))
+    assert set(screen_candidates.signatures) == loaded
