@@ -42,7 +42,19 @@ def candidate_limit(dim: int, query_code_norm: float) -> tuple[float, float]:
     return eta, rho
 
 
-@numba.njit(cache=True, nogil=True, boundscheck=False, fastmath={"contract"})
+def _compiled(function):
+    """`function` compiled by numba, cached on disk beside the package (or in the user's
+    cache) so that later processes load it in 0.2 s. Where no cache directory is writable (a
+    read-only install without a home directory) numba refuses to cache: it is then compiled
+    once per process instead, about 1 s."""
+    options = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
+    try:
+        return numba.njit(cache=True, **options)(function)
+    except RuntimeError:
+        return numba.njit(**options)(function)
+
+
+@_compiled
 def screen_candidates(
     codes: np.ndarray,
     n: int,

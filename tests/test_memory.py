@@ -130,3 +130,33 @@ def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
     memory.extend(np.random.default_rng(5).uniform(-1, 1, (100, 14)))
     memory.nearest(np.zeros(14))
     assert set(screen_candidates.signatures) == loaded
+
+
+def test_memory_works_where_numba_cannot_cache(tmp_path) -> None:
+    """A read-only install without a writable home: numba finds no cache directory (here: its
+    only allowed one is a path under a file) and the kernel is compiled in the process."""
+    import os
+    import subprocess
+    import sys
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    env = dict(
+        os.environ,
+        NUMBA_CACHE_LOCATOR_CLASSES="UserProvidedCacheLocator",
+        NUMBA_CACHE_DIR=str(blocker / "cache"),
+    )
+    code = (
+        "import numpy as np\n"
+        "from learner.memory import NearestNeighbourMemory, brute_force_nearest\n"
+        "rows = np.random.default_rng(6).uniform(-1, 1, (3000, 12))\n"
+        "memory = NearestNeighbourMemory(12)\n"
+        "memory.extend(rows)\n"
+        "q = np.full(12, 0.5)\n"
+        "assert memory.nearest(q) == brute_force_nearest(rows, q)\n"
+        "print('exact')\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "exact"
+    assert not (blocker.parent / "cache").exists()
