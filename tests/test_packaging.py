@@ -74,6 +74,21 @@ def test_an_installed_wheel_runs_a_trial_outside_the_repository(tmp_path):
         check=True, capture_output=True, text=True, cwd=work, env=env,
     ).stdout  # fmt: skip
     assert str(REPO) not in where and str(env_dir) in where
+    # The memory's compiled kernel, compiled and cached from the installed package.
+    query = (
+        "import numpy as np, learner.memory as m\n"
+        "rows = np.random.default_rng(0).uniform(-1, 1, (2000, 10))\n"
+        "memory = m.NearestNeighbourMemory(10)\n"
+        "memory.extend(rows)\n"
+        "q = np.linspace(-1, 1, 10)\n"
+        "assert memory.nearest(q) == m.brute_force_nearest(rows, q)\n"
+        "print(m.__file__)\n"
+    )
+    kernel = subprocess.run(
+        [python, "-c", query], capture_output=True, text=True, cwd=work, env=env
+    )
+    assert kernel.returncode == 0, kernel.stderr
+    assert str(env_dir) in kernel.stdout
     result = subprocess.run(
         [env_dir / "bin" / "playroom", "run", "--grasp", "physical", "--iterations", "25",
          "--out", str(work / "trial"), "--quiet"],
