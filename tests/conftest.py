@@ -13,6 +13,23 @@ import pytest  # noqa: E402
 
 
 @pytest.fixture(scope="session")
+def savez_round_trip():
+    """state dict -> the same dict written by np.savez and read back, as checkpoints are."""
+    import io
+
+    import numpy as np
+
+    def round_trip(state: dict) -> dict:
+        buffer = io.BytesIO()
+        np.savez(buffer, **state)
+        buffer.seek(0)
+        with np.load(buffer, allow_pickle=False) as loaded:
+            return {key: loaded[key] for key in loaded.files}
+
+    return round_trip
+
+
+@pytest.fixture(scope="session")
 def trained_trial(tmp_path_factory):
     """One short kinematic trial, trained once for the whole session: 3000 iterations, seed 0,
     checkpoints every 1000. Its `.dir` holds the trial. Tests only read it: one that writes

@@ -4,7 +4,6 @@ config modules are read, for the study's numbers)."""
 from __future__ import annotations
 
 import copy
-import io
 
 import numpy as np
 import pytest
@@ -30,14 +29,6 @@ def _world(seed: int) -> SyntheticWorld:
         recognition_distance=DEFAULT_VOICE.recognition_distance,
         replace_period=DEFAULT_WORLD.toy_replace_period,
     )
-
-
-def _savez_round_trip(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    buffer = io.BytesIO()
-    np.savez(buffer, **state)
-    buffer.seek(0)
-    with np.load(buffer, allow_pickle=False) as loaded:
-        return {key: loaded[key] for key in loaded.files}
 
 
 def _run(agent: Agent, world: SyntheticWorld, n: int) -> list[Proposal]:
@@ -247,7 +238,7 @@ def test_heard_sounds_come_from_arm_movements_only() -> None:
     assert np.all(agent.heard_sounds == 0.3)
 
 
-def test_same_seed_same_run_and_restored_agent_continues_identically() -> None:
+def test_same_seed_same_run_and_restored_agent_continues_identically(savez_round_trip) -> None:
     def proposals_of(agent: Agent, world: SyntheticWorld, n: int) -> list[np.ndarray]:
         return [p.m for p in _run(agent, world, n)]
 
@@ -257,7 +248,7 @@ def test_same_seed_same_run_and_restored_agent_continues_identically() -> None:
     for x, y in zip(proposals_of(a, world_a, 400), proposals_of(b, world_b, 400), strict=True):
         np.testing.assert_array_equal(x, y)
 
-    state = _savez_round_trip(a.state_dict())
+    state = savez_round_trip(a.state_dict())
     restored = Agent(config, rng=999)  # a different seed: the state overrides it
     restored.load_state_dict(state)
     world_c = copy.deepcopy(world_a)

@@ -3,20 +3,10 @@ however its 8-bit screening codes round the rows."""
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 import pytest
 
 from learner.memory import NearestNeighbourMemory, brute_force_nearest
-
-
-def _savez_round_trip(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    buffer = io.BytesIO()
-    np.savez(buffer, **state)
-    buffer.seek(0)
-    with np.load(buffer, allow_pickle=False) as loaded:
-        return {key: loaded[key] for key in loaded.files}
 
 
 def _assert_brute_force(memory: NearestNeighbourMemory, rows: np.ndarray, queries) -> None:
@@ -83,7 +73,7 @@ def test_memory_widens_its_grid_for_large_values() -> None:
     _assert_brute_force(extended, rows, rng.uniform(-50, 50, (20, 10)))
 
 
-def test_memory_state_round_trip_gives_identical_answers() -> None:
+def test_memory_state_round_trip_gives_identical_answers(savez_round_trip) -> None:
     rng = np.random.default_rng(1)
     rows = rng.uniform(-1, 1, (1500, 14))
     rows[700] = 3.0  # the grid is rebuilt from the rows alone
@@ -91,7 +81,7 @@ def test_memory_state_round_trip_gives_identical_answers() -> None:
     for row in rows[:1000]:
         memory.append(row)
     restored = NearestNeighbourMemory(14)
-    restored.load_state_dict(_savez_round_trip(memory.state_dict()))
+    restored.load_state_dict(savez_round_trip(memory.state_dict()))
     for row in rows[1000:]:  # both keep growing after the restore
         memory.append(row)
         restored.append(row)
