@@ -144,12 +144,14 @@ def competence_table(
 
 
 def vocal_table(best_word_distance: np.ndarray, names: tuple[str, ...]) -> pd.DataFrame:
-    """One row per word: its best distance to any sound the agent produced, name or not."""
+    """One row per word: its best distance to any sound the agent produced, name or not, and
+    the toy it names (names[i] names toy i + 1; 0 for a distractor)."""
     words = DEFAULT_VOICE.words
     return pd.DataFrame(
         {
             "word": list(words),
             "is_name": [w in names for w in words],
+            "toy": [names.index(w) + 1 if w in names else 0 for w in words],
             "best_distance": np.asarray(best_word_distance, dtype=float),
         }
     )

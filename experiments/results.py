@@ -45,7 +45,8 @@ class BatchResults:
       seconds / timed_iterations (NaN when not recorded).
     - competence: competence.parquet rows (ring, placement, toy, x, y, distance, strategy,
       error, random_error, ...).
-    - vocal: vocal.parquet rows (word, is_name, best_distance).
+    - vocal: vocal.parquet rows (word, is_name, toy, best_distance); `toy` (the toy a name
+      names, 0 for a distractor) is missing in trials evaluated before it was recorded.
     - curves: long table (iteration, metric, value) of developmental curves
       (experiments/curves.py).
     - configs: group -> the group's common config (trial.seed removed).

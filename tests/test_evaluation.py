@@ -18,6 +18,7 @@ from experiments.evaluation import (
     normalised_competence,
     strategy_of,
 )
+from experiments.trial import load_trial
 from models.layout import ARM_DIM
 from sim import Playroom
 
@@ -96,6 +97,11 @@ def test_eval_of_a_trial_writes_its_files_and_leaves_the_trial_unchanged(
     assert len(summary["vocal"]["best_distance"]) == 6 and len(summary["vocal"]["names"]) == 3
     for name in ("eval.json", "competence.parquet", "vocal.parquet"):
         assert (trial / name).exists()
+    # Each name row says which toy it names, in the room's order of names.
+    vocal = pd.read_parquet(trial / "vocal.parquet")
+    names = load_trial(trial)[2].words.names
+    named = vocal[vocal["toy"] > 0].sort_values("toy")
+    assert tuple(named["word"]) == names and (vocal["toy"] > 0).equals(vocal["is_name"])
     assert (trial / "checkpoint.npz").read_bytes() == checkpoint
     assert main(["eval", str(trial), "--placements", "2", "--quiet"]) == 0
     assert "normalised competence" in capsys.readouterr().out
