@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from experiments import paper
+from experiments import name_strategies, paper
 from experiments.figures import FigureFile, report_figures
 from experiments.report_html import (
     Table,
@@ -288,5 +288,6 @@ def write_comparison(
         paper=published,
         reference=paper.reference(),
         trials=trials_table(merged),
+        **name_strategies.page_context(merged, geometry.threshold),
     )
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page)

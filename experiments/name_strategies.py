@@ -88,6 +88,16 @@ def name_strategy_table(results: BatchResults, threshold: float) -> Table | None
     return Table(header, rows)
 
 
+def page_context(results: BatchResults, threshold: float) -> dict:
+    """What the pages' "Strategies by the toy's name" section reads (macros.html.j2)."""
+    table = name_strategy_table(results, threshold)
+    return {
+        "has_study_tests": not results.study_tests.empty,
+        "name_strategies": table,
+        "name_strategies_note": NOT_RECORDED if table is None else "",
+    }
+
+
 def _cells(shares: pd.DataFrame, rings: list[int], outer: int, said: str) -> list[str]:
     """A row's cells after its label: toys, said share, vocal per ring, the outer ring's
     shares."""

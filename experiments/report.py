@@ -13,10 +13,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments import paper
+from experiments import name_strategies, paper
 from experiments.comparison import COMPARISON_FILE, write_comparison
 from experiments.figures import report_figures
-from experiments.name_strategies import NOT_RECORDED, name_strategy_table
 from experiments.report_html import render, settings_table, trials_table, write_page
 from experiments.results import Geometry, ReportError, collect
 from experiments.statistics import summarise
@@ -45,7 +44,6 @@ def write_report(
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
     figures += study_figure_files(results, published)
-    by_name = name_strategy_table(results, geometry.threshold)
     page = render(
         "report.html.j2",
         title=f"Playroom batch report: {results.batch_dir.name}",
@@ -58,9 +56,7 @@ def write_report(
         paper=published,
         reference=paper.reference(),
         trials=trials_table(results),
-        name_strategies=by_name,
-        name_strategies_note=NOT_RECORDED if by_name is None else "",
-        has_study_tests=not results.study_tests.empty,
+        **name_strategies.page_context(results, geometry.threshold),
     )
     out = Path(out_dir) if out_dir is not None else results.batch_dir
     return write_page(out, figures, REPORT_FILE, page)

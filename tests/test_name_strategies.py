@@ -105,3 +105,14 @@ def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
         pd.read_parquet(path).drop(columns="toy").to_parquet(path)
     page = write_report(batch, tmp_path / "old-report", 50).read_text()
     assert "playroom eval" in page and NOT_RECORDED.split(":")[0] in page
+
+
+def test_the_comparison_splits_both_backends_by_name(batches, tmp_path):
+    from experiments.report import write_comparison
+
+    page = write_comparison(
+        batches["kinematic"], batches["physical"], tmp_path, 20, study_reference_commands=50
+    ).read_text()
+    section = page[page.index("Strategies by the toy") : page.index("<h2>Trials</h2>")]
+    for group in ("kinematic", "physical"):
+        assert f"<td>{group}</td>" in section
