@@ -8,7 +8,7 @@
   after it grows with the rows lying within a grid step (1/127) of the nearest, usually one.
 - `learner_overhead`: seconds per iteration of `propose` + `learn` (model choice, inverse
   query, noise, storing into every model of the motor space, interest update) when every model
-  holds `n_rows` experiences; the world's time is excluded (a synthetic world is used).
+  holds `n_rows` experiences, in the world the caller passes, whose time is excluded.
 """
 
 from __future__ import annotations
