@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
 OUT ?= runs
 
-.PHONY: install run test test-slow lint format bench voice-model experiment compare video replicate ablations clean
+.PHONY: install run test test-slow lint format bench voice-model experiment compare video replicate comparison ablations clean
 
 $(INSTALLED): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -45,6 +45,12 @@ video: $(INSTALLED)
 replicate: $(INSTALLED)
 	$(BIN)/playroom batch --profile replication --out $(OUT)/replication
 	$(BIN)/playroom report $(OUT)/replication
+
+## comparison: both backends at the study's scale per trial (the comparison profile: 16 seeds x
+## 80000 each, study preset) and their comparison page; about an hour on 2 cores, resumes
+comparison: $(INSTALLED)
+	$(BIN)/playroom batch --profile comparison --out $(OUT)/comparison
+	$(BIN)/playroom compare $(OUT)/comparison $(OUT)/comparison --out $(OUT)/comparison-report
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the

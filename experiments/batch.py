@@ -23,11 +23,11 @@ from pathlib import Path
 from tqdm import tqdm
 
 from experiments import storage
+from experiments.cli_args import stored_profiles
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
 from experiments.lock import DirectoryLock
 from experiments.trial import CHECKPOINT_FILE, TrialSettings, run_trial
 
-PROFILES = ("smoke", "demo", "paper", "replication")
 TIMING_FILE = "timing.json"
 # How long to wait for a scheduler that does not answer.
 CONNECT_TIMEOUT_S = 10
@@ -79,12 +79,13 @@ class BatchSpec:
 def load_spec(
     profile: str | None = None, config_file: str | os.PathLike | None = None
 ) -> BatchSpec:
-    """A stored profile (smoke, demo, paper) or a JSON file of the same form."""
+    """A stored profile (experiments/profiles/NAME.json) or a JSON file of the same form."""
     if (profile is None) == (config_file is None):
         raise BatchError("give exactly one of --profile NAME or --config FILE")
     if profile is not None:
-        if profile not in PROFILES:
-            raise BatchError(f"unknown profile {profile!r}: choose one of {', '.join(PROFILES)}")
+        if profile not in stored_profiles():
+            choices = ", ".join(stored_profiles())
+            raise BatchError(f"unknown profile {profile!r}: choose one of {choices}")
         text = resources.files("experiments").joinpath(f"profiles/{profile}.json").read_text()
         source = f"profile {profile}"
     else:

@@ -15,6 +15,7 @@ from experiments.cli_args import (
     iteration_list,
     non_negative_int,
     positive_int,
+    stored_profiles,
 )
 
 
@@ -310,7 +311,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("batch", help="many trials on a Dask cluster, each run and evaluated")
     which = p.add_mutually_exclusive_group(required=True)
-    which.add_argument("--profile", help="a stored profile: smoke, demo or paper")
+    which.add_argument("--profile", help=f"a stored profile: {', '.join(stored_profiles())}")
     which.add_argument("--config", help="a JSON file of the same form as the profiles")
     p.add_argument("--out", required=True, help="the batch directory")
     p.add_argument("--scheduler", help="tcp://HOST:PORT of a running Dask scheduler")

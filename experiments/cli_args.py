@@ -3,6 +3,14 @@
 from __future__ import annotations
 
 import argparse
+from importlib import resources
+
+
+def stored_profiles() -> list[str]:
+    """The batch profiles shipped in experiments/profiles/, by name."""
+    folder = resources.files("experiments").joinpath("profiles")
+    names = (f.name for f in folder.iterdir())
+    return sorted(name.removesuffix(".json") for name in names if name.endswith(".json"))
 
 
 class UsageError(Exception):

@@ -152,3 +152,7 @@ def test_stored_profiles_hold_what_the_readme_says():
     assert replication.grasps == ("kinematic",) and len(replication.seeds) == 100
     assert replication.iterations == 80000 and replication.preset == "study"
     assert all(s.preset == "study" for _, s in replication.trials())
+    comparison = load_spec("comparison")
+    assert set(comparison.grasps) == {"kinematic", "physical"} and len(comparison.seeds) == 16
+    assert comparison.iterations == 80000 and comparison.eval_placements == 100
+    assert all(s.preset == "study" for _, s in comparison.trials())
