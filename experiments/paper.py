@@ -19,11 +19,9 @@ from typing import Any
 from experiments.report_html import Table, ci_text, num, p_value, pct, shares_text
 from experiments.results import BatchResults, Geometry
 from experiments.statistics import DISTANCE_ONE
-from experiments.study_measure import RANDOM_COMMANDS_PER_RING
+from experiments.study_measure import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
 
 PAPER_FILE = "paper.json"
-# Below this share of the disk's pixels holding a test, the study's strategy shares are flagged.
-FULL_COVERAGE = 0.9
 # A number the paper does not give (per ring competence): said so, not left blank.
 NOT_PUBLISHED = "not published"
 
@@ -189,7 +187,8 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         [
             f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
             f"random reference of {commands} commands per ring, the study's "
-            f"{RANDOM_COMMANDS_PER_RING}; 95% intervals over runs resampled)",
+            f"{RANDOM_COMMANDS_PER_RING}; 95% intervals over runs resampled, given where the "
+            f"tests cover {pct(FULL_COVERAGE)} of the disk's pixels or more)",
             paper["competence_all"].text,
             *[of(x, competence) for x in groups],
         ],

@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from experiments.study_measure import (
+    FULL_COVERAGE,
     GRID,
     StudyMeasureSettings,
     _arm_context_of_the_study,
@@ -112,21 +113,30 @@ def test_tests_and_reference_on_a_trained_trial(trained_trial):
     assert 0.0 <= summary["competence"]["all"] <= 1.0
 
 
-def test_intervals_resample_runs_and_vanish_when_runs_agree():
-    rng = np.random.default_rng(5)
-    n = 600
-    one_run = pd.DataFrame(
+def _one_test_per_disk_pixel(rng: np.random.Generator) -> pd.DataFrame:
+    """A run whose tests cover every pixel of the disk, one test each."""
+    centres = (np.arange(GRID) + 0.5) / (GRID / 2) - 1.0
+    x, y = (a.ravel() for a in np.meshgrid(centres, centres, indexing="ij"))
+    inside = np.hypot(x, y) < 1.0
+    n = int(inside.sum())
+    return pd.DataFrame(
         {
-            "x": rng.uniform(-0.7, 0.7, n),
-            "y": rng.uniform(-0.7, 0.7, n),
+            "x": x[inside],
+            "y": y[inside],
             "error": rng.uniform(0.0, 1.0, n),
             "strategy": rng.choice(["hand", "tool", "vocal"], n),
             "ring": rng.integers(1, 4, n),
         }
     )
+
+
+def test_intervals_resample_runs_and_vanish_when_runs_agree():
+    rng = np.random.default_rng(5)
+    one_run = _one_test_per_disk_pixel(rng)
     reference = one_run.assign(error=1.0)
     copies = pd.concat([one_run.assign(trial=f"t{k}") for k in range(4)], ignore_index=True)
     summary = study_summary(copies, reference)
+    assert summary["coverage"] == pytest.approx(1.0, abs=0.01)
     low, high = summary["intervals"]["competence_all"]
     assert low == pytest.approx(summary["competence"]["all"]) == pytest.approx(high)
     assert "intervals" not in study_summary(one_run.assign(trial="t0"), reference)
@@ -136,7 +146,8 @@ def test_intervals_resample_runs_and_vanish_when_runs_agree():
     low, high = summary["intervals"]["competence_all"]
     assert low < summary["competence"]["all"] < high
     low, high = summary["intervals"]["strategy_share"]["centre"]["hand"]
-    assert 0.0 <= low <= summary["strategy_share"]["centre"]["hand"] <= high <= 1.0
+    share = summary["strategy_share"]["centre"]["hand"]
+    assert 0.0 <= low <= share + 1e-12 and share - 1e-12 <= high <= 1.0
 
 
 def test_coverage_counts_the_disk_pixels_holding_a_test():
@@ -153,3 +164,18 @@ def test_coverage_counts_the_disk_pixels_holding_a_test():
     disk = (np.sqrt((gi - 50) ** 2 + (gj - 50) ** 2) < 50).sum()
     summary = study_summary(tests, tests.assign(error=1.0))
     assert summary["coverage"] == pytest.approx(2 / disk)
+
+
+def test_no_intervals_where_the_tests_cover_too_few_pixels():
+    """A resample repeats runs and covers fewer pixels, which lowers every renormalised
+    share: below FULL_COVERAGE the intervals would miss their own estimates, so there are
+    none."""
+    rng = np.random.default_rng(6)
+    runs = []
+    for k in range(4):  # each run covers a random quarter of the disk's pixels
+        run = _one_test_per_disk_pixel(rng)
+        runs.append(run[rng.random(len(run)) < 1 / 4].assign(trial=f"t{k}"))
+    tests = pd.concat(runs, ignore_index=True)
+    summary = study_summary(tests, tests.assign(error=1.0))
+    assert summary["coverage"] < FULL_COVERAGE and "intervals" not in summary
+    assert 0.0 <= summary["competence"]["all"] <= 1.0
