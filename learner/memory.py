@@ -110,11 +110,7 @@ class NearestNeighbourMemory:
         n = self._n
         self._rows[n] = row
         self._n = n + 1
-        max_abs = float(np.abs(row).max())
-        if max_abs > self._scale:
-            self._recode(max_abs)
-        else:
-            self._codes[:, n] = np.rint(row * (CODE_MAX / self._scale))
+        self._code_from(n)
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""
@@ -130,11 +126,7 @@ class NearestNeighbourMemory:
         n = self._n
         self._rows[n : n + k] = rows
         self._n = n + k
-        max_abs = float(np.abs(rows).max())
-        if max_abs > self._scale:
-            self._recode(max_abs)
-        else:
-            self._codes[:, n : n + k] = np.rint(rows.T * (CODE_MAX / self._scale))
+        self._code_from(n)
 
     def nearest(self, query: ArrayLike) -> tuple[int, float]:
         """(index of the nearest row, Euclidean distance), as `brute_force_nearest` answers.
@@ -214,8 +206,12 @@ class NearestNeighbourMemory:
         self._rows[: self._n] = rows
         self._codes[:, : self._n] = codes
 
-    def _recode(self, max_abs: float) -> None:
-        """Widen the grid to hold |value| up to max_abs and re-code every stored row."""
-        self._scale = max(self._scale, _scale_for(max_abs))
-        n = self._n
-        self._codes[:, :n] = np.rint(self._rows[:n].T * (CODE_MAX / self._scale))
+    def _code_from(self, start: int) -> None:
+        """Write the codes of the rows from `start` on; a value beyond the grid widens it and
+        re-codes every stored row."""
+        max_abs = float(np.abs(self._rows[start : self._n]).max())
+        if max_abs > self._scale:
+            self._scale = _scale_for(max_abs)
+            start = 0
+        codes = np.rint(self._rows[start : self._n].T * (CODE_MAX / self._scale))
+        self._codes[:, start : self._n] = codes
