@@ -96,8 +96,11 @@ def source_record(root: Path | None = None) -> dict[str, Any]:
             return {"commit": None, "dirty": None, "where": INSTALLED}
         commit = _git(root, "rev-parse", "HEAD")
         dirty = bool(_git(root, "status", "--porcelain", "--untracked-files=no"))
-    except subprocess.CalledProcessError:  # not a repository, or git refuses it
-        return {"commit": None, "dirty": None, "where": INSTALLED}
+    except subprocess.CalledProcessError as exc:  # not a repository, or git refuses it
+        if not (root / ".git").exists():
+            return {"commit": None, "dirty": None, "where": INSTALLED}
+        why = (exc.stderr or "").strip().splitlines()[:1] or [f"exit code {exc.returncode}"]
+        return {"commit": None, "dirty": None, "where": f"unknown (git: {why[0]})"}
     except (OSError, subprocess.TimeoutExpired) as exc:  # no git, or a hung file system
         return {"commit": None, "dirty": None, "where": f"unknown (git: {type(exc).__name__})"}
     return {"commit": commit, "dirty": dirty, "where": "git checkout"}
@@ -207,22 +210,28 @@ def bit_differences(a: dict, b: dict) -> list[str]:
         if x != y:
             out.append(f"{label} {_text(x)} -> {_text(y)}")
 
-    ca, cb = a.get("cpu", {}), b.get("cpu", {})
+    ca, cb = _part(a, "cpu"), _part(b, "cpu")
     for key, label in (("model", "CPU"), ("machine", "arch"), ("numba_target", "numba CPU")):
         differ(label, ca.get(key), cb.get(key))
     for key in ("baseline", "dispatched"):
-        differ(f"SIMD {key}", a.get("simd", {}).get(key), b.get("simd", {}).get(key))
-    differ("BLAS", _blas_text(a.get("blas", [])), _blas_text(b.get("blas", [])))
-    va, vb = a.get("versions", {}), b.get("versions", {})
+        differ(f"SIMD {key}", _part(a, "simd").get(key), _part(b, "simd").get(key))
+    differ("BLAS", _blas_text(a.get("blas")), _blas_text(b.get("blas")))
+    va, vb = _part(a, "versions"), _part(b, "versions")
     for name in ("python", *COMPUTING):
         differ(name, va.get(name), vb.get(name))
-    ea, eb = a.get("environment", {}), b.get("environment", {})
+    ea, eb = _part(a, "environment"), _part(b, "environment")
     for key in sorted(set(ea) | set(eb)):
         differ(key, ea.get(key, "unset"), eb.get(key, "unset"))
-    commits = [r.get("source", {}).get("commit") for r in (a, b)]
+    commits = [_part(r, "source").get("commit") for r in (a, b)]
     if all(commits):
         differ("commit", *(c[:10] for c in commits))
     return out
+
+
+def _part(record: dict, key: str) -> dict:
+    """A section of a record; {} when it is missing or not a dict (a hand-edited file)."""
+    part = record.get(key)
+    return part if isinstance(part, dict) else {}
 
 
 def _text(value: Any) -> str:
@@ -231,8 +240,9 @@ def _text(value: Any) -> str:
     return str(value)
 
 
-def _blas_text(blas: list[dict]) -> str:
+def _blas_text(blas: Any) -> str:
     """'openblas 0.3.31 Haswell' per library, joined by '; '."""
+    blas = [b for b in blas if isinstance(b, dict)] if isinstance(blas, list) else []
     parts = [f"{b.get('library')} {b.get('version')} {b.get('kernel')}" for b in blas]
     return "; ".join(parts) or "none"
 
@@ -248,17 +258,16 @@ def short_record(record: dict | None) -> dict[str, str] | None:
     """The record in the few fields reports show (SHORT_FIELDS); None for None."""
     if record is None:
         return None
-    simd = record.get("simd", {})
-    versions = record.get("versions", {})
+    simd, versions = _part(record, "simd"), _part(record, "versions")
     return {
         "host": str(record.get("host")),
-        "cpu": str(record.get("cpu", {}).get("model")),
+        "cpu": str(_part(record, "cpu").get("model")),
         # The dispatched targets found say the level; without any, the baseline is the level.
         "simd": " ".join(simd.get("dispatched") or simd.get("baseline") or ["none"]),
-        "blas": _blas_text(record.get("blas", [])),
+        "blas": _blas_text(record.get("blas")),
         "numpy": str(versions.get("numpy")),
         "mujoco": str(versions.get("mujoco")),
-        "commit": commit_text(record.get("source", {})),
+        "commit": commit_text(_part(record, "source")),
     }
 
 

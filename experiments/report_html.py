@@ -182,7 +182,7 @@ def where_table(results: BatchResults) -> tuple[Table, str]:
     moved = int((computed.groupby("trial").size() > 1).sum())
     note = (
         f"{moved} trial{'s' if moved != 1 else ''} changed machine or library set on a resume "
-        "and count under each."
+        f"and count{'' if moved != 1 else 's'} under each."
         if moved
         else "Each trial was computed on one machine and library set."
     )
