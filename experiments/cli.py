@@ -78,6 +78,7 @@ def cmd_eval(args: argparse.Namespace) -> None:
     """Competence, strategies and vocal accuracy of a trial's final state."""
     from experiments import storage
     from experiments.evaluation import EvaluationSettings, evaluate_trial
+    from experiments.provenance import computed_on_line
     from experiments.trial import TrialError
 
     try:
@@ -91,6 +92,7 @@ def cmd_eval(args: argparse.Namespace) -> None:
         f"{args.dir}: {summary['grasp']}, seed {summary['seed']}, "
         f"{summary['evaluated_at_iteration']} iterations"
     )
+    print(f"  {computed_on_line(args.dir)}")
     print(
         "  normalised competence (0 = random agent, 1 = perfect): "
         + ", ".join(f"{k} {val:+.2f}" for k, val in c.items())

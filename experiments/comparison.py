@@ -27,6 +27,7 @@ from experiments.report_html import (
     settings_table,
     shares_text,
     trials_table,
+    where_table,
     write_page,
 )
 from experiments.results import COMPETENCE_SCOPES, BatchResults, Geometry, ReportError, collect
@@ -270,6 +271,7 @@ def write_comparison(
         + study_figure_files(merged, published)
     ]
     g = merged.groups
+    where, where_note = where_table(merged)
     page = render(
         "comparison.html.j2",
         title=f"Playroom comparison: {g[0]} vs {g[1]}",
@@ -288,6 +290,8 @@ def write_comparison(
         paper=published,
         reference=paper.reference(),
         trials=trials_table(merged),
+        where=where,
+        where_note=where_note,
         **name_strategies.page_context(merged, geometry.threshold),
     )
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page)

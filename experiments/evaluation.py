@@ -11,7 +11,8 @@ a random command) acts on the very same placements: normalised competence is
 
 Every test starts from the same scene: the stick at its start place, the toys at the placement,
 a seeded caregiver position. The trial's own files are read, never written, except the
-evaluation's outputs (`eval.json`, `competence.parquet`, `vocal.parquet`).
+evaluation's outputs (`eval.json`, `competence.parquet`, `vocal.parquet`); eval.json names the
+machine it was computed on (`evaluated_on`, experiments/provenance.py).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import storage
+from experiments import provenance, storage
 from experiments.lock import DirectoryLock, DirectoryLocked
 from experiments.trial import TrialLocked, load_trial
 from learner.agent import Agent
@@ -211,6 +212,8 @@ def evaluate_trial(
         summary = summarise(config, competence, vocal)
         summary["evaluated_at_iteration"] = int(meta["iteration"])
         summary["n_placements"] = settings.n_placements
+        # The evaluation is computed too: its numbers carry the machine's bits as well.
+        summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
         # The study measured in the scene learning left, carried over from test to test.
         from experiments.study_measure import StudyMeasureSettings, study_tests
 

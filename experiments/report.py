@@ -16,7 +16,7 @@ from pathlib import Path
 from experiments import name_strategies, paper
 from experiments.comparison import COMPARISON_FILE, write_comparison
 from experiments.figures import report_figures
-from experiments.report_html import render, settings_table, trials_table, write_page
+from experiments.report_html import render, settings_table, trials_table, where_table, write_page
 from experiments.results import Geometry, ReportError, collect
 from experiments.statistics import summarise
 from experiments.study_figures import study_figure_files
@@ -44,6 +44,7 @@ def write_report(
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
     figures += study_figure_files(results, published)
+    where, where_note = where_table(results)
     page = render(
         "report.html.j2",
         title=f"Playroom batch report: {results.batch_dir.name}",
@@ -56,6 +57,8 @@ def write_report(
         paper=published,
         reference=paper.reference(),
         trials=trials_table(results),
+        where=where,
+        where_note=where_note,
         **name_strategies.page_context(results, geometry.threshold),
     )
     out = Path(out_dir) if out_dir is not None else results.batch_dir

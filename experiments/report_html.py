@@ -143,6 +143,52 @@ def trials_table(results: BatchResults) -> Table:
     return Table(header, rows)
 
 
+# Rows of BatchResults.provenance: who computed a trial, who evaluated it.
+ROLES = ("computed", "evaluated")
+
+
+def _counts_text(rows: pd.DataFrame, groups: list[str]) -> str:
+    """How many distinct trials `rows` hold, per group when the page shows several."""
+    n = rows["trial"].nunique()
+    if n == 0 or len(groups) < 2:
+        return str(n)
+    per = [f"{g} {rows.loc[rows['group'] == g, 'trial'].nunique()}" for g in groups]
+    return f"{n} ({', '.join(p for p in per if not p.endswith(' 0'))})"
+
+
+def where_table(results: BatchResults) -> tuple[Table, str]:
+    """Where the trials ran: one row per machine and library set (CPU, NumPy's SIMD, BLAS
+    kernel, numpy and mujoco versions, host, commit) with the trials computed and evaluated
+    there; trials from before provenance was recorded count as "not recorded". Returns the
+    table and a sentence about trials computed on more than one machine."""
+    from experiments.provenance import SHORT_FIELDS
+
+    where = results.provenance
+    if "status" not in where:  # results built without it (none read from a batch)
+        return Table([], []), "Not recorded."
+    header = ["CPU", "NumPy SIMD", "BLAS (kernel)", "numpy", "mujoco", "host", "commit"]
+    header += [f"trials {role}" for role in ROLES]
+    unknown = {"not recorded": "not recorded (older trials)", "unreadable": "record unreadable"}
+    rows = []
+    # Recorded machines first, in the order trials were read; unknown ones last.
+    groups = where.groupby(["status", *SHORT_FIELDS], sort=False)
+    for values, here in sorted(groups, key=lambda g: g[0][0] != "recorded"):
+        status, *fields = values
+        if status != "recorded":
+            fields = [unknown.get(status, status)] + [""] * (len(SHORT_FIELDS) - 1)
+        counts = [_counts_text(here[here["role"] == role], results.groups) for role in ROLES]
+        rows.append([*fields, *counts])
+    computed = where[where["role"] == "computed"]
+    moved = int((computed.groupby("trial").size() > 1).sum())
+    note = (
+        f"{moved} trial{'s' if moved != 1 else ''} changed machine or library set on a resume "
+        f"and count{'' if moved != 1 else 's'} under each."
+        if moved
+        else "Each trial was computed on one machine and library set."
+    )
+    return Table(header, rows), note
+
+
 # Pages -----------------------------------------------------------------------------------------
 
 

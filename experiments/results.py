@@ -24,6 +24,7 @@ import pandas as pd
 from experiments import storage
 from experiments.curves import curve_rows, tool_numbers
 from experiments.evaluation import COMPETENCE_FILE, EVAL_FILE, STUDY_TESTS_FILE, VOCAL_FILE
+from experiments.provenance import SHORT_FIELDS, computed_on
 from experiments.trial import CONFIG_FILE, read_log
 
 TIMING_FILE = "timing.json"
@@ -50,6 +51,10 @@ class BatchResults:
     - curves: long table (iteration, metric, value) of developmental curves
       (experiments/curves.py).
     - configs: group -> the group's common config (trial.seed removed).
+    - provenance: where each trial was computed (role 'computed', one row per stretch of
+      iterations, from provenance.json) and evaluated (role 'evaluated', from eval.json):
+      from_iteration, status ('recorded', 'not recorded', 'unreadable') and
+      provenance.SHORT_FIELDS (cpu, simd, blas, numpy, mujoco, host, commit).
     """
 
     batch_dir: Path
@@ -60,6 +65,9 @@ class BatchResults:
     configs: dict[str, dict]
     study_tests: pd.DataFrame = dataclasses.field(
         default_factory=lambda: pd.DataFrame(columns=["group"])
+    )
+    provenance: pd.DataFrame = dataclasses.field(
+        default_factory=lambda: pd.DataFrame(columns=["group", "seed"])
     )
 
     @property
@@ -101,6 +109,7 @@ class BatchResults:
             "vocal": self.vocal,
             "curves": self.curves,
             "study_tests": self.study_tests,
+            "provenance": self.provenance,
         }
 
 
@@ -260,6 +269,18 @@ def _timing(trial_dir: Path) -> tuple[float, float]:
         raise ReportError(f"{path} lacks 'seconds' and 'iterations' numbers") from None
 
 
+def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]:
+    """Where a trial was computed (provenance.json) and evaluated (eval.json's
+    `evaluated_on`): rows of BatchResults.provenance. Trials from before either was recorded
+    have rows of status 'not recorded'; the report counts them as such."""
+    rows = [{**keys, "role": "computed", **stretch} for stretch in computed_on(d)]
+    evaluated = summary.get("evaluated_on")
+    status = "recorded" if isinstance(evaluated, dict) else "not recorded"
+    fields = {k: str(evaluated.get(k, "?")) if evaluated else "" for k in SHORT_FIELDS}
+    rows.append({**keys, "role": "evaluated", "from_iteration": 0, "status": status, **fields})
+    return rows
+
+
 def _trial_rows(
     d: Path, config: dict, summary: dict, label: str
 ) -> tuple[dict[str, Any], pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
@@ -325,6 +346,13 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
     ]
     trials, competence, vocal, curves, study = zip(*rows, strict=True)
+    where = [
+        row
+        for d, summary, row_keys in zip(dirs, evals, trials, strict=True)
+        for row in _provenance_rows(
+            d, summary, {k: row_keys[k] for k in ("trial", "group", "seed")}
+        )
+    ]
     studied = [t for t in study if t is not None]
     return BatchResults(
         batch_dir=batch_dir,
@@ -336,4 +364,5 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         study_tests=(
             pd.concat(studied, ignore_index=True) if studied else pd.DataFrame(columns=["group"])
         ),
+        provenance=pd.DataFrame(where),
     )

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import storage
+from experiments import provenance, storage
 from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
 from experiments.trial_files import (  # noqa: F401 (the trial's files are read from here too)
     CHECKPOINT_FILE,
@@ -153,6 +153,8 @@ class Trial:
             self.start_iteration = 0
             if resume:
                 self._resume()
+            if not self.finished:  # who computes from here on (provenance.json)
+                self.notices += provenance.record_start(self.dir, self.iteration)
         except BaseException:
             self.close()
             raise

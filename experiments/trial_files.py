@@ -9,6 +9,8 @@ A trial directory holds:
   one file per checkpoint period, starting at iteration NNNNNNNN;
 - `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
   of the 6 words;
+- `provenance.json`: the machine, libraries and commit that computed each stretch of
+  iterations, one entry per run or resume (experiments/provenance.py);
 - `.lock`: the lock of its one writer (experiments/lock.py).
 Everything else in it (evaluation, timing, videos) is derived from the trial at some iteration.
 The writer is experiments/trial.py.
@@ -24,6 +26,7 @@ import pandas as pd
 
 from experiments import storage
 from experiments.lock import LOCK_FILE
+from experiments.provenance import DAMAGED_PROVENANCE_FILE, PROVENANCE_FILE
 from learner.agent import Agent
 from learner.config import LearnerConfig
 from models.layout import TOYS, context_indices
@@ -47,6 +50,8 @@ TRIAL_ENTRIES = (
     DAMAGED_CHECKPOINT_FILE,
     LOG_DIR,
     LOCK_FILE,
+    PROVENANCE_FILE,
+    DAMAGED_PROVENANCE_FILE,
 )
 STALE_PREFIX = "stale-at-"
 

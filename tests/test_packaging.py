@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -96,3 +97,10 @@ def test_an_installed_wheel_runs_a_trial_outside_the_repository(tmp_path):
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert "25 iterations (physical" in result.stdout
+    # An installed package has no commit to record: its provenance says where it came from.
+    entries = json.loads((work / "trial" / "provenance.json").read_text())
+    assert entries[0]["record"]["source"] == {
+        "commit": None,
+        "dirty": None,
+        "where": "installed package",
+    }
