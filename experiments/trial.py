@@ -30,12 +30,9 @@ from tqdm import tqdm
 from experiments import storage
 from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
 from experiments.trial_checks import (  # noqa: F401 (load_trial: read from here too)
-    check_logs,
     drop_logs_past,
     load_trial,
-    refuse_logs_without_checkpoint,
-    remove_litter,
-    restore_newest,
+    prepare_resume,
 )
 from experiments.trial_files import (  # noqa: F401 (the trial's files are read from here too)
     CHECKPOINT_FILE,
@@ -229,40 +226,16 @@ class Trial:
         storage.write_arrays(newest, arrays, meta)
 
     def _resume(self) -> None:
-        """Load the newest usable checkpoint, check the logs it covers, drop the logs past it
-        and the litter of killed writers, and extend the trial if more iterations are asked
-        for than it was run with. Everything is checked before anything is changed."""
-        d = self.dir
-        newest = d / CHECKPOINT_FILE
-        if not newest.exists() and not (d / PREVIOUS_CHECKPOINT_FILE).exists():
-            refuse_logs_without_checkpoint(d)
-            self.notices.append(f"{d} holds no checkpoint yet: starting it from iteration 0")
-        else:
-            self.agent, self.room, meta, fallback = restore_newest(d, self.config)
+        """Load the newest usable checkpoint (its logs checked before anything is changed),
+        drop the logs past it and the litter of killed writers, and extend the trial if more
+        iterations are asked for than it was run with."""
+        restored = prepare_resume(self.dir, self.config, self.notices)
+        if restored is not None:
+            self.agent, self.room, meta = restored
             self.iteration = int(meta["iteration"])
-            check_logs(d, self.iteration)
-            if "identity" not in meta:
-                self.notices.append(
-                    "the checkpoint predates trial identities (no seed or config hash in it): "
-                    "taken as this trial's; the next checkpoint carries one"
-                )
-            if fallback is not None:
-                kept = ""
-                if newest.exists():  # damaged, not missing: kept for whoever looks into it
-                    os.replace(newest, d / DAMAGED_CHECKPOINT_FILE)
-                    kept = f" (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
-                self.notices.append(
-                    f"{fallback}; resumed from the previous checkpoint "
-                    f"({PREVIOUS_CHECKPOINT_FILE}), at iteration {self.iteration}{kept}"
-                )
             self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
             self.counts = dict(meta["counts"])
-        litter = remove_litter(d)
-        if litter:
-            self.notices.append(
-                f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
-            )
-        drop_logs_past(d, self.iteration)  # the lost work's: rewritten by the run
+        drop_logs_past(self.dir, self.iteration)  # the lost work's: rewritten by the run
         self._extend_if_asked()
 
     def _extend_if_asked(self) -> None:

@@ -18,6 +18,7 @@ from experiments import storage
 from experiments.trial_files import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
+    DAMAGED_CHECKPOINT_FILE,
     LOG_DIR,
     PREVIOUS_CHECKPOINT_FILE,
     WORDS_LOG_PERIOD,
@@ -176,18 +177,53 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     return removed
 
 
-def refuse_logs_without_checkpoint(trial_dir: Path) -> None:
-    """TrialError if a trial directory holds log chunks but neither checkpoint. A run writes a
-    checkpoint at iteration 0 before its first chunk (experiments/trial.py), so such logs are
-    a trial whose checkpoints were lost, and restarting it from 0 would delete them."""
-    chunks = [p for p in (trial_dir / LOG_DIR).glob("*.parquet") if log_chunk_start(p) is not None]
-    if chunks:
-        raise TrialError(
-            f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint ({CHECKPOINT_FILE} "
-            f"and {PREVIOUS_CHECKPOINT_FILE} are missing): resuming would restart it from "
-            "iteration 0 and delete its logs; refusing. Restore the checkpoints, or run the "
-            "trial again from scratch into a new directory"
+def prepare_resume(
+    trial_dir: Path, config: dict, notices: list[str]
+) -> tuple[Agent, Playroom, dict] | None:
+    """What a resume starts from: (agent, room, checkpoint meta) of the newest usable
+    checkpoint whose logs are whole, or None to start from iteration 0 (no checkpoint and no
+    logs yet). Everything is checked before anything is changed; then a damaged newest
+    checkpoint is kept as checkpoint.damaged.npz and the litter of killed writers removed.
+    Appends to `notices` one line per thing done or noticed. TrialError if the trial cannot
+    be resumed (the message says why and what can be done)."""
+    newest = trial_dir / CHECKPOINT_FILE
+    if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
+        # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
+        # trial.py): logs without one are a trial whose checkpoints were lost.
+        chunks = [p for p in (trial_dir / LOG_DIR).glob("*") if log_chunk_start(p) is not None]
+        if chunks:
+            raise TrialError(
+                f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint "
+                f"({CHECKPOINT_FILE} and {PREVIOUS_CHECKPOINT_FILE} are missing): resuming "
+                "would restart it from iteration 0 and delete its logs; refusing. Restore the "
+                "checkpoints, or run the trial again from scratch into a new directory"
+            )
+        notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
+        restored = None
+    else:
+        agent, room, meta, fallback = restore_newest(trial_dir, config)
+        check_logs(trial_dir, int(meta["iteration"]))
+        restored = agent, room, meta
+        if "identity" not in meta:
+            notices.append(
+                "the checkpoint predates trial identities (no seed or config hash in it): "
+                "taken as this trial's; the next checkpoint carries one"
+            )
+        if fallback is not None:
+            kept = ""
+            if newest.exists():  # damaged, not missing: kept for whoever looks into it
+                os.replace(newest, trial_dir / DAMAGED_CHECKPOINT_FILE)
+                kept = f" (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
+            notices.append(
+                f"{fallback}; resumed from the previous checkpoint ({PREVIOUS_CHECKPOINT_FILE}), "
+                f"at iteration {meta['iteration']}{kept}"
+            )
+    litter = remove_litter(trial_dir)
+    if litter:
+        notices.append(
+            f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
         )
+    return restored
 
 
 def drop_logs_past(trial_dir: Path, iteration: int) -> None:
