@@ -26,7 +26,9 @@ from experiments import storage
 from experiments.cli_args import stored_profiles
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
 from experiments.lock import DirectoryLock
-from experiments.trial import CHECKPOINT_FILE, TrialSettings, run_trial
+from experiments.trial import CHECKPOINT_FILE, CONFIG_FILE, TrialError, TrialSettings, run_trial
+from experiments.trial_checks import check_logs
+from experiments.trial_files import check_identity
 
 TIMING_FILE = "timing.json"
 # How long to wait for a scheduler that does not answer.
@@ -125,14 +127,22 @@ def load_spec(
 
 
 def is_complete(trial_dir: Path) -> bool:
-    """Whether a trial ran to its end and was evaluated."""
-    if not (trial_dir / EVAL_FILE).exists() or not (trial_dir / CHECKPOINT_FILE).exists():
-        return False
+    """Whether a trial ran to its end, is whole (its own checkpoint, logs complete up to it)
+    and was evaluated there: what a rerun may skip. Whatever is not (a truncated eval.json,
+    a lost log chunk) is run again, which evaluates it again or reports the damage."""
     try:
+        config = storage.read_json(trial_dir / CONFIG_FILE)
         _, meta = storage.read_arrays(trial_dir / CHECKPOINT_FILE)
-    except storage.CorruptFileError:
+        summary = storage.read_json(trial_dir / EVAL_FILE)
+        if not meta.get("finished") or not isinstance(summary, dict):
+            return False
+        if summary.get("evaluated_at_iteration") != meta["iteration"]:
+            return False
+        check_identity(trial_dir / CHECKPOINT_FILE, meta, config)
+        check_logs(trial_dir, int(meta["iteration"]))
+    except (OSError, KeyError, storage.CorruptFileError, TrialError):
         return False
-    return bool(meta.get("finished"))
+    return True
 
 
 def run_and_evaluate(trial_dir: str, settings: TrialSettings, eval_placements: int) -> dict:

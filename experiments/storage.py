@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,17 @@ import pandas as pd
 
 class CorruptFileError(Exception):
     """A file of a trial directory cannot be read back (truncated, damaged)."""
+
+
+# The temporary file `write_bytes` writes beside NAME: `.NAME.PID.tmp`, PID its writer's.
+_TEMPORARY = re.compile(r"\.(?P<name>.+)\.(?P<pid>[0-9]+)\.tmp")
+
+
+def temporary_writer(name: str) -> int | None:
+    """The process id of the writer of a temporary file of `write_bytes` named `name` (a file
+    that a writer killed mid-write may leave behind); None if `name` is not such a file."""
+    match = _TEMPORARY.fullmatch(name)
+    return None if match is None else int(match["pid"])
 
 
 def write_bytes(path: Path, data: bytes) -> None:
@@ -78,6 +90,21 @@ def read_table(path: Path) -> pd.DataFrame:
         return pd.read_parquet(path)
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+
+
+def read_column(path: Path, name: str) -> list:
+    """One column of a table written by `write_table`, as a list; every column is read and
+    decoded (a check that the whole file is readable, at half the cost of `read_table`).
+    CorruptFileError if the file cannot be read or lacks the column."""
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+    if name not in table.column_names:
+        raise CorruptFileError(f"{path} has no column {name!r}")
+    return table.column(name).to_pylist()
 
 
 def config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, Any, Any]]:

@@ -29,21 +29,27 @@ from tqdm import tqdm
 
 from experiments import provenance, storage
 from experiments.lock import LOCK_FILE, DirectoryLock, DirectoryLocked
+from experiments.trial_checks import (  # noqa: F401 (load_trial: read from here too)
+    drop_logs_past,
+    load_trial,
+    prepare_resume,
+)
 from experiments.trial_files import (  # noqa: F401 (the trial's files are read from here too)
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
+    EXTENSIBLE,
     LOG_DIR,
     PREVIOUS_CHECKPOINT_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
+    WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
     fresh_trial_parts,
-    load_trial,
     log_row,
     read_log,
-    restore_checkpoint,
+    trial_identity,
 )
 from learner.config import LearnerConfig, learner_preset
 from models.layout import TOYS, block_slice
@@ -51,10 +57,6 @@ from sim.config import PRESETS, WorldConfig, world_preset
 from sim.experimenter import STICK_RETURNS
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
-
-# Iterations between two rows of the words log: the vocal learning curves are read every 100
-# iterations (docs/protocol.md §10).
-WORDS_LOG_PERIOD = 100
 
 
 @dataclass(frozen=True)
@@ -121,10 +123,6 @@ def full_config(
     }
     # Through JSON and back, so that it compares equal to what config.json holds.
     return json.loads(json.dumps(config))
-
-
-# Settings a resume may change: a trial can be extended to more iterations.
-EXTENSIBLE = ("trial.iterations",)
 
 
 class Trial:
@@ -220,6 +218,8 @@ class Trial:
             "finished": self.finished,
             "room": room_state,
             "counts": self.counts,
+            # Whose checkpoint it is: one copied into another trial is refused there.
+            "identity": trial_identity(self.config),
         }
         newest = self.dir / CHECKPOINT_FILE
         if newest.exists():
@@ -228,32 +228,16 @@ class Trial:
         storage.write_arrays(newest, arrays, meta)
 
     def _resume(self) -> None:
-        """Load the newest readable checkpoint, drop the logs past it, and extend the trial
-        if more iterations are asked for than it was run with."""
-        newest = self.dir / CHECKPOINT_FILE
-        previous = self.dir / PREVIOUS_CHECKPOINT_FILE
-        if newest.exists() or previous.exists():
-            try:
-                meta = restore_checkpoint(self.dir, self.agent, self.room)
-            except storage.CorruptFileError as exc:
-                if not previous.exists():
-                    raise
-                # A restore that failed half-way may have changed them: start from fresh parts.
-                self.agent, self.room = fresh_trial_parts(self.config)
-                meta = restore_checkpoint(self.dir, self.agent, self.room, PREVIOUS_CHECKPOINT_FILE)
-                if newest.exists():
-                    os.replace(newest, self.dir / DAMAGED_CHECKPOINT_FILE)
-                self.notices.append(
-                    f"{exc}; resumed from the previous checkpoint, at iteration "
-                    f"{meta['iteration']} (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
-                )
-            self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
+        """Load the newest usable checkpoint (its logs checked before anything is changed),
+        drop the logs past it and the litter of killed writers, and extend the trial if more
+        iterations are asked for than it was run with."""
+        restored = prepare_resume(self.dir, self.config, self.notices)
+        if restored is not None:
+            self.agent, self.room, meta = restored
             self.iteration = int(meta["iteration"])
+            self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
             self.counts = dict(meta["counts"])
-        # Log chunks past the checkpoint belong to the lost work: they are rewritten.
-        for chunk in (self.dir / LOG_DIR).glob("*.parquet"):
-            if int(chunk.stem.split("-")[1]) >= self.iteration:
-                chunk.unlink()
+        drop_logs_past(self.dir, self.iteration)  # the lost work's: rewritten by the run
         self._extend_if_asked()
 
     def _extend_if_asked(self) -> None:
@@ -268,8 +252,15 @@ class Trial:
                 "would shorten it"
             )
         stale = self.dir / f"{STALE_PREFIX}{self.iteration:08d}"
-        derived = [p for p in self.dir.iterdir() if p.name not in TRIAL_ENTRIES]
-        derived = [p for p in derived if not p.name.startswith(STALE_PREFIX)]
+        # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a
+        # writer (one `remove_litter` spared): none is a result derived from the trial.
+        derived = [
+            p
+            for p in self.dir.iterdir()
+            if p.name not in TRIAL_ENTRIES
+            and not p.name.startswith(STALE_PREFIX)
+            and storage.temporary_writer(p.name) is None
+        ]
         if derived:
             stale.mkdir(exist_ok=True)
             for path in derived:
@@ -298,6 +289,10 @@ class Trial:
 
     def _run_to(self, total: int, bar: tqdm) -> None:
         """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
+        if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
+            # A checkpoint before the first log chunk: a directory with logs then always has
+            # a checkpoint, unless it was lost, and a resume can tell which (`_resume`).
+            self._save_checkpoint()
         rows: list[dict] = []
         word_rows: list[dict] = []
         chunk_start = self.iteration

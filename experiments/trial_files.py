@@ -8,16 +8,19 @@ A trial directory holds:
 - `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
   one file per checkpoint period, starting at iteration NNNNNNNN;
 - `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
-  of the 6 words;
+  of the 6 words, in the chunk of the period that reaches them;
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
   iterations, one entry per run or resume (experiments/provenance.py);
 - `.lock`: the lock of its one writer (experiments/lock.py).
 Everything else in it (evaluation, timing, videos) is derived from the trial at some iteration.
-The writer is experiments/trial.py.
+The writer is experiments/trial.py; experiments/trial_checks.py reads a trial back only
+when it is whole (its checkpoint its own and readable, the logs it covers complete).
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 from pathlib import Path
 
@@ -54,6 +57,17 @@ TRIAL_ENTRIES = (
     DAMAGED_PROVENANCE_FILE,
 )
 STALE_PREFIX = "stale-at-"
+# Iterations between two rows of the words log: the vocal learning curves are read every 100
+# iterations (docs/protocol.md §10).
+WORDS_LOG_PERIOD = 100
+
+# Settings a resume may change: a trial can be extended to more iterations.
+EXTENSIBLE = ("trial.iterations",)
+# What a checkpoint's identity leaves out of its trial's config: the settings a resume may
+# change, and the package version. The version says which code wrote config.json, not which
+# trial it is; in the identity it would orphan every checkpoint at each release (whether a
+# trial may be resumed by another version is for the config comparison on resume to say).
+_NOT_IDENTITY = (*EXTENSIBLE, "package_version")
 
 
 # The agent's random generator is seeded apart from the room's, from the same trial seed.
@@ -119,15 +133,53 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     return agent, room
 
 
+def trial_identity(config: dict) -> dict:
+    """What a checkpoint carries of its trial (in its metadata): the seed, and a hash of the
+    trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
+    kept = json.loads(json.dumps(config))  # a deep copy
+    for key in _NOT_IDENTITY:
+        *parents, last = key.split(".")
+        node = kept
+        for parent in parents:
+            node = node.get(parent, {})
+        node.pop(last, None)
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    return {"seed": config["trial"]["seed"], "config": digest}
+
+
+def check_identity(path: Path, meta: dict, config: dict) -> None:
+    """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
+    A checkpoint without identity (written before checkpoints carried one) is taken as the
+    trial's: the caller says so where it can."""
+    found, own = meta.get("identity"), trial_identity(config)
+    if found is None or found == own:
+        return
+    seed, digest = (
+        (found.get("seed"), found.get("config")) if isinstance(found, dict) else 2 * ("?",)
+    )
+    raise TrialError(
+        f"{path.name} belongs to another trial (seed {seed}, config {digest}) than "
+        f"{path.parent} (seed {own['seed']}, config {own['config']}); refusing to mix them"
+    )
+
+
 def restore_checkpoint(
-    trial_dir: str | os.PathLike, agent: Agent, room: Playroom, name: str = CHECKPOINT_FILE
+    trial_dir: str | os.PathLike,
+    agent: Agent,
+    room: Playroom,
+    name: str = CHECKPOINT_FILE,
+    *,
+    config: dict,
 ) -> dict:
     """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
-    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored."""
+    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored;
+    TrialError if it belongs to another trial than `config`'s."""
     path = Path(trial_dir) / name
     if not path.exists():
         raise storage.CorruptFileError(f"{path} is missing")
     arrays, meta = storage.read_arrays(path)
+    check_identity(path, meta, config)
     try:
         agent_state = {
             k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")
@@ -138,26 +190,6 @@ def restore_checkpoint(
     except (KeyError, ValueError, TypeError) as exc:
         raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
     return meta
-
-
-def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
-    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta)."""
-    trial_dir = Path(trial_dir)
-    if not (trial_dir / CONFIG_FILE).exists():
-        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
-        raise TrialError(f"{trial_dir} has no checkpoint yet")
-    config = storage.read_json(trial_dir / CONFIG_FILE)
-    agent, room = fresh_trial_parts(config)
-    try:
-        meta = restore_checkpoint(trial_dir, agent, room)
-    except storage.CorruptFileError as exc:
-        if (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
-            raise storage.CorruptFileError(
-                f"{exc}; `playroom run --resume` continues from the previous checkpoint"
-            ) from None
-        raise
-    return config, agent, room, meta
 
 
 def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:

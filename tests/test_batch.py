@@ -39,11 +39,15 @@ def client():
     cluster.close()
 
 
-def _wait_for(path: Path, polls: int = 2400) -> None:
-    """Poll (every 50 ms, at most `polls` times) until `path` exists; no clock is read."""
+def _wait_for_first_checkpoint(trial_dir: Path, polls: int = 2400) -> None:
+    """Poll (every 50 ms, at most `polls` times) until the trial has a checkpoint past
+    iteration 0 (a run writes one at 0 before it starts); no clock is read."""
     for _ in range(polls):
-        if path.exists():
-            return
+        try:
+            if storage.read_arrays(trial_dir / CHECKPOINT_FILE)[1]["iteration"] > 0:
+                return
+        except (FileNotFoundError, storage.CorruptFileError):
+            pass
         time.sleep(0.05)
 
 
@@ -73,7 +77,7 @@ def test_rerun_resumes_an_unfinished_trial_from_its_checkpoint(tmp_path, client)
     args = [sys.executable, "-m", "experiments.cli", "run", "--grasp", "kinematic"]
     args += ["--iterations", "1500", "--seed", "0", "--checkpoint-every", "100", "--quiet"]
     proc = subprocess.Popen([*args, "--out", str(trial_dir)])
-    _wait_for(trial_dir / CHECKPOINT_FILE)
+    _wait_for_first_checkpoint(trial_dir)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert not is_complete(trial_dir)
@@ -99,7 +103,7 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
         batch = pool.submit(run_batch, spec, tmp_path, client=client, progress=False)
         # Wait until a trial has checkpointed, then kill the worker running it.
         target = tmp_path / spec.trials()[0][0]
-        _wait_for(target / CHECKPOINT_FILE)
+        _wait_for_first_checkpoint(target)
         pids = client.run(os.getpid)
         running = [a for a, keys in client.processing().items() if target.name in keys]
         assert len(running) == 1, client.processing()
