@@ -127,10 +127,6 @@ def run_batch(
             client, own_cluster = dask_scheduler.connect(scheduler, n_workers)
         except dask_scheduler.SchedulerError as exc:
             raise BatchError(str(exc)) from None
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise BatchError(f"cannot create {out}: {exc.strerror}") from None
     bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
     if notify is None:
         notify = lambda line: bar.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
@@ -138,8 +134,14 @@ def run_batch(
     topic = f"playroom-batch-{run}"
     results: dict[str, dict] = {}
     failures: dict[str, str] = {}
-    try:
+    listening = False
+    try:  # from here on, the cluster this batch started is closed however the batch ends
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise BatchError(f"cannot create {out}: {exc.strerror}") from None
         dask_scheduler.listen(client, topic, notify)
+        listening = True
         futures = {}
         for name, settings in todo:
             trial_dir = out / name
@@ -159,7 +161,7 @@ def run_batch(
                 # Only a lost scheduler cancels a batch's tasks: its keys are its own.
                 if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
                     raise _lost(scheduler, todo, results) from None
-                failures[name] = f"{type(exc).__name__}: {exc}"
+                failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
             bar.update(1)
             try:
                 threads = sum(client.nthreads().values())
@@ -178,7 +180,7 @@ def run_batch(
         if own_cluster is not None:
             client.close()
             own_cluster.close()
-        elif not dask_scheduler.scheduler_lost(client):
+        elif listening and not dask_scheduler.scheduler_lost(client):
             client.unsubscribe_topic(topic)
     if failures:
         listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
