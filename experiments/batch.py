@@ -12,118 +12,31 @@ started on PBS or SLURM nodes by dask-jobqueue (README). Each trial is one Dask 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
-import logging
 import os
+import sys
 import time
-from dataclasses import dataclass, field
-from importlib import resources
+import uuid
+from collections.abc import Callable
+from concurrent.futures import CancelledError
 from pathlib import Path
 
 from tqdm import tqdm
 
+from experiments import scheduler as dask_scheduler
 from experiments import storage
-from experiments.cli_args import stored_profiles
+from experiments.batch_spec import BatchError, BatchSpec, load_spec  # noqa: F401 (read from here)
 from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
-from experiments.lock import DirectoryLock
+from experiments.lock import DirectoryLock, DirectoryLocked
 from experiments.trial import CHECKPOINT_FILE, CONFIG_FILE, TrialError, TrialSettings, run_trial
 from experiments.trial_checks import check_logs
 from experiments.trial_files import check_identity
 
 TIMING_FILE = "timing.json"
-# How long to wait for a scheduler that does not answer.
-CONNECT_TIMEOUT_S = 10
 # How long a batch task waits for another writer of its trial to finish (s): longer than a
 # trial of the paper profile takes on one core.
 LOCK_WAIT_S = 4 * 3600
-
-
-class BatchError(Exception):
-    """A batch that cannot run as asked; the message says why."""
-
-
-@dataclass(frozen=True)
-class BatchSpec:
-    """Which trials a batch holds and how each is run and evaluated."""
-
-    grasps: tuple[str, ...] = ("kinematic", "physical")
-    babbling: tuple[str, ...] = ("random",)
-    seeds: tuple[int, ...] = (0, 1, 2)
-    iterations: int = 1000
-    checkpoint_every: int = 1000
-    eval_placements: int = 100
-    stick_return: str = "out_of_reach"
-    preset: str = "study"
-    overrides: dict = field(default_factory=dict)
-    description: str = field(default="", compare=False)
-
-    def trials(self) -> list[tuple[str, TrialSettings]]:
-        """(directory name, settings) of every trial, in a stable order."""
-        out = []
-        for grasp in self.grasps:
-            for babbling in self.babbling:
-                for seed in self.seeds:
-                    name = f"{grasp}-{babbling}-seed{seed:04d}"
-                    settings = TrialSettings(
-                        grasp=grasp,
-                        iterations=self.iterations,
-                        seed=seed,
-                        babbling=babbling,
-                        checkpoint_every=min(self.checkpoint_every, self.iterations),
-                        stick_return=self.stick_return,
-                        preset=self.preset,
-                        overrides=self.overrides,
-                    )
-                    out.append((name, settings))
-        return out
-
-
-def load_spec(
-    profile: str | None = None, config_file: str | os.PathLike | None = None
-) -> BatchSpec:
-    """A stored profile (experiments/profiles/NAME.json) or a JSON file of the same form."""
-    if (profile is None) == (config_file is None):
-        raise BatchError("give exactly one of --profile NAME or --config FILE")
-    if profile is not None:
-        if profile not in stored_profiles():
-            choices = ", ".join(stored_profiles())
-            raise BatchError(f"unknown profile {profile!r}: choose one of {choices}")
-        text = resources.files("experiments").joinpath(f"profiles/{profile}.json").read_text()
-        source = f"profile {profile}"
-    else:
-        path = Path(config_file)
-        if not path.is_file():
-            raise BatchError(f"batch config {path} does not exist")
-        text, source = path.read_text(), str(path)
-    try:
-        raw = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise BatchError(f"{source} is not valid JSON ({exc})") from None
-    known = {f.name for f in dataclasses.fields(BatchSpec)} - {"description"}
-    unknown = sorted(set(raw) - known - {"description"})
-    if unknown:
-        raise BatchError(f"{source}: unknown field(s) {', '.join(unknown)}")
-    seeds = raw.get("seeds", 3)
-    seeds = tuple(range(seeds)) if isinstance(seeds, int) else tuple(int(s) for s in seeds)
-    try:
-        spec = BatchSpec(
-            grasps=tuple(raw.get("grasps", ("kinematic", "physical"))),
-            babbling=tuple(raw.get("babbling", ("random",))),
-            seeds=seeds,
-            iterations=int(raw.get("iterations", 1000)),
-            checkpoint_every=int(raw.get("checkpoint_every", 1000)),
-            eval_placements=int(raw.get("eval_placements", 100)),
-            stick_return=str(raw.get("stick_return", "out_of_reach")),
-            preset=str(raw.get("preset", "study")),
-            overrides=dict(raw.get("overrides", {})),
-            description=raw.get("description", ""),
-        )
-        spec.trials()  # validates every trial's settings
-    except Exception as exc:
-        raise BatchError(f"{source}: {exc}") from None
-    if not spec.seeds:
-        raise BatchError(f"{source}: no seeds")
-    return spec
 
 
 def is_complete(trial_dir: Path) -> bool:
@@ -145,12 +58,24 @@ def is_complete(trial_dir: Path) -> bool:
     return True
 
 
-def run_and_evaluate(trial_dir: str, settings: TrialSettings, eval_placements: int) -> dict:
-    """One batch task: run or resume the trial, then evaluate it. Safe to run again."""
+def run_and_evaluate(
+    trial_dir: str, settings: TrialSettings, eval_placements: int, topic: str | None = None
+) -> dict:
+    """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
+    for another writer of the trial is told to the client listening on `topic`."""
     path = Path(trial_dir)
     # Dask may run a task again while its first attempt still runs on a worker it lost touch
-    # with: the second waits for the first to end instead of writing beside it.
-    lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
+    # with: the second waits for the first to end instead of writing beside it. So does a
+    # task whose trial another batch or `playroom run` writes: the user hears of it.
+    try:
+        lock = DirectoryLock(path).acquire()
+    except DirectoryLocked as exc:
+        dask_scheduler.tell_client(
+            topic,
+            f"waiting (up to {LOCK_WAIT_S / 3600:g} h) for another writer of {path.name} to "
+            f"finish: {exc}",
+        )
+        lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
     try:
         resume = (path / "config.json").exists()
         start = time.perf_counter()
@@ -171,27 +96,13 @@ def run_and_evaluate(trial_dir: str, settings: TrialSettings, eval_placements: i
     return summary
 
 
-def _client(scheduler: str | None, n_workers: int | None):
-    """A Dask client: to the given scheduler, or to a new LocalCluster of worker processes."""
-    from distributed import Client, LocalCluster
-
-    # The scheduler's and nannies' INFO lines would bury the progress bar.
-    logging.getLogger("distributed").setLevel(logging.WARNING)
-    if scheduler is not None:
-        try:
-            return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s"), None
-        except (OSError, TimeoutError) as exc:
-            raise BatchError(
-                f"no Dask scheduler answered at {scheduler} within {CONNECT_TIMEOUT_S} s ({exc})"
-            ) from None
-    cluster = LocalCluster(
-        n_workers=n_workers or os.cpu_count() or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
-    return Client(cluster), cluster
+def task_key(name: str, trial_dir: Path, settings: TrialSettings, placements: int, run: str) -> str:
+    """The Dask key of a trial's task: its name (as the dashboard shows it), a digest of where
+    and what it runs, and the run's token. Tasks of one key are one task to a scheduler, shared
+    by every client that submits it: so no other batch, configuration or run may ever share a
+    key (a second run of the same batch waits on the trials' locks instead)."""
+    what = json.dumps([str(trial_dir), dataclasses.asdict(settings), placements], sort_keys=True)
+    return f"{name}-{hashlib.sha256(what.encode()).hexdigest()[:8]}-{run}"
 
 
 def run_batch(
@@ -201,19 +112,19 @@ def run_batch(
     n_workers: int | None = None,
     client=None,
     progress: bool = True,
+    notify: Callable[[str], None] | None = None,
 ) -> dict[str, dict]:
     """Run every trial of `spec` under out_dir (skipping completed ones); returns the
     evaluation summary of each trial run now, by name. Trials that fail are reported and the
-    others go on; BatchError at the end names the failures."""
+    others go on; BatchError at the end names the failures, or at once says the scheduler is
+    not one or was lost. `notify` gets the lines said while trials run (default: stderr)."""
     from distributed import as_completed
 
-    out = Path(out_dir)
+    # Workers may run in another directory, or on another machine sharing the file system:
+    # they are sent the path the user meant, not one relative to where they run.
+    out = Path(os.path.abspath(Path(out_dir).expanduser()))
     if out.exists() and not out.is_dir():
         raise BatchError(f"{out} is a file, not a directory")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise BatchError(f"cannot create {out}: {exc.strerror}") from None
     todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
     skipped = len(spec.trials()) - len(todo)
     if not todo:
@@ -222,23 +133,34 @@ def run_batch(
         return {}
     own_cluster = None
     if client is None:
-        client, own_cluster = _client(scheduler, n_workers)
+        try:
+            client, own_cluster = dask_scheduler.connect(scheduler, n_workers)
+        except dask_scheduler.SchedulerError as exc:
+            raise BatchError(str(exc)) from None
+    bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
+    if notify is None:
+        notify = lambda line: bar.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
+    run = uuid.uuid4().hex[:8]
+    topic = f"playroom-batch-{run}"
     results: dict[str, dict] = {}
     failures: dict[str, str] = {}
-    try:
-        futures = {
-            client.submit(
-                run_and_evaluate,
-                str(out / name),
-                settings,
-                spec.eval_placements,
-                key=name,
-                pure=False,
-                retries=2,
-            ): name
-            for name, settings in todo
-        }
-        bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
+    listening = False
+    try:  # from here on, the cluster this batch started is closed however the batch ends
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise BatchError(f"cannot create {out}: {exc.strerror}") from None
+        dask_scheduler.listen(client, topic, notify)
+        listening = True
+        futures = {}
+        for name, settings in todo:
+            trial_dir = out / name
+            key = task_key(name, trial_dir, settings, spec.eval_placements, run)
+            future = client.submit(
+                run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
+                key=key, pure=False, retries=2,
+            )  # fmt: skip
+            futures[future] = name
         if skipped and progress:
             bar.write(f"skipping {skipped} complete trial(s)")
         for future in as_completed(futures):
@@ -246,22 +168,41 @@ def run_batch(
             try:
                 results[name] = future.result()
             except Exception as exc:  # a trial's error must not stop the others
-                failures[name] = f"{type(exc).__name__}: {exc}"
+                # Only a lost scheduler cancels a batch's tasks: its keys are its own.
+                if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
+                    raise _lost(scheduler, todo, results) from None
+                failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
             bar.update(1)
+            try:
+                threads = sum(client.nthreads().values())
+            except OSError:  # the scheduler went away
+                raise _lost(scheduler, todo, results) from None
             # Dask may queue more tasks on a worker than it has threads: at most one task per
             # thread runs, the rest of the unfinished ones wait.
             unfinished = sum(not f.done() for f in futures)
-            running = min(unfinished, sum(client.nthreads().values()))
-            waiting = unfinished - running
+            running = min(unfinished, threads)
             bar.set_postfix(
-                done=len(results), running=running, waiting=waiting, failed=len(failures)
-            )
-        bar.close()
+                done=len(results), running=running, waiting=unfinished - running,
+                failed=len(failures),
+            )  # fmt: skip
     finally:
+        bar.close()
         if own_cluster is not None:
             client.close()
             own_cluster.close()
+        elif listening and not dask_scheduler.scheduler_lost(client):
+            client.unsubscribe_topic(topic)
     if failures:
         listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
         raise BatchError(f"{len(failures)} trial(s) failed: {listed}")
     return results
+
+
+def _lost(scheduler: str | None, todo: list, results: dict) -> BatchError:
+    """The error of a batch whose scheduler went away."""
+    where = f"at {scheduler}" if scheduler else "of the batch"
+    left = len(todo) - len(results)
+    return BatchError(
+        f"lost the Dask scheduler {where} with {left} trial(s) unfinished; run the same "
+        "command again: complete trials are kept, the others resume from their checkpoints"
+    )

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from experiments import batch as batch_module
+from experiments import scheduler as scheduler_module
 from experiments import storage
 from experiments.batch import (
     TIMING_FILE,
@@ -105,7 +105,11 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
         target = tmp_path / spec.trials()[0][0]
         _wait_for_first_checkpoint(target)
         pids = client.run(os.getpid)
-        running = [a for a, keys in client.processing().items() if target.name in keys]
+        running = [
+            a
+            for a, keys in client.processing().items()
+            if any(k.startswith(f"{target.name}-") for k in keys)  # keys: name-digest-run
+        ]
         assert len(running) == 1, client.processing()
         os.kill(pids[running[0]], signal.SIGKILL)
         results = batch.result(timeout=300)
@@ -121,7 +125,7 @@ def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, clie
 
 def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys, monkeypatch):
     # Nothing listens on port 9: a short wait for the scheduler is enough to give up.
-    monkeypatch.setattr(batch_module, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(scheduler_module, "CONNECT_TIMEOUT_S", 1)
     with pytest.raises(BatchError, match="unknown profile"):
         load_spec("huge")
     bad = tmp_path / "bad.json"
@@ -143,6 +147,98 @@ def test_bad_batch_input_is_a_one_line_error(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert "no Dask scheduler answered" in err and len(err.strip().splitlines()) == 1
     assert not any(Path(tmp_path / "b").glob("*/config.json"))
+
+
+def _tiny(preset: str = "study", seeds: tuple[int, ...] = (0,)) -> BatchSpec:
+    return BatchSpec(
+        grasps=("kinematic",), seeds=seeds, iterations=100, checkpoint_every=100,
+        eval_placements=1, preset=preset,
+    )  # fmt: skip
+
+
+def test_two_batches_with_the_same_trial_names_on_one_scheduler_stay_apart(tmp_path, client):
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed import Client
+
+    study, project = _tiny("study"), _tiny("project")
+    name = study.trials()[0][0]
+    assert name == project.trials()[0][0]
+    # Two users' clients of one scheduler, the second submitting while the first one's trial
+    # of the same name runs.
+    with Client(client.scheduler.address) as other, ThreadPoolExecutor(1) as pool:
+        first = pool.submit(run_batch, study, tmp_path / "a", client=client, progress=False)
+        _wait_for(tmp_path / "a" / name / "config.json")
+        second = run_batch(project, tmp_path / "b", client=other, progress=False)
+        first = first.result(timeout=300)
+    for batch, spec, results in (("a", study, first), ("b", project, second)):
+        trial = tmp_path / batch / name
+        assert is_complete(trial), batch
+        assert storage.read_json(trial / "config.json")["trial"]["preset"] == spec.preset
+        written = storage.read_json(trial / "eval.json")
+        assert results[name] == {**written, "wall_seconds": results[name]["wall_seconds"]}
+
+
+def test_a_relative_out_is_where_the_client_runs_not_where_the_workers_do(
+    tmp_path, client, monkeypatch
+):
+    here, elsewhere = tmp_path / "client", tmp_path / "worker"
+    here.mkdir()
+    elsewhere.mkdir()
+    monkeypatch.chdir(here)
+    before = client.run(os.getcwd)
+    client.run(os.chdir, str(elsewhere))
+    try:
+        results = run_batch(_tiny(), "batch", client=client, progress=False)
+    finally:
+        for address, cwd in before.items():
+            client.run(os.chdir, cwd, workers=[address])
+    name = _tiny().trials()[0][0]
+    assert list(results) == [name] and is_complete(here / "batch" / name)
+    assert not (elsewhere / "batch").exists()
+
+
+_HOLD = """import fcntl, os, sys
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)
+fcntl.flock(fd, fcntl.LOCK_EX)
+os.pwrite(fd, f"{os.getpid()}\\n".encode(), 0)
+print("held", flush=True)
+sys.stdin.read()
+"""
+
+
+def test_a_batch_says_when_a_trial_waits_for_another_writer(tmp_path, client):
+    from concurrent.futures import ThreadPoolExecutor
+
+    spec = _tiny()
+    trial = tmp_path / spec.trials()[0][0]
+    trial.mkdir()
+    # Another process writes the trial (its lock taken as experiments/lock.py takes it).
+    holder = subprocess.Popen(
+        [sys.executable, "-c", _HOLD, str(trial / ".lock")],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    said: list[str] = []
+    try:
+        assert holder.stdout.readline() == "held\n"
+        with ThreadPoolExecutor(1) as pool:
+            batch = pool.submit(
+                run_batch, spec, tmp_path, client=client, progress=False, notify=said.append
+            )
+            for _ in range(1200):  # the task tells it before it waits (at most 60 s here)
+                if said:
+                    break
+                time.sleep(0.05)
+            assert not batch.done()
+            holder.stdin.close()  # the other writer ends: the batch goes on
+            holder.wait()
+            results = batch.result(timeout=300)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert len(said) == 1, said
+    assert f"pid {holder.pid}" in said[0] and str(trial) in said[0] and "4 h" in said[0]
+    assert list(results) == [trial.name] and is_complete(trial)
 
 
 def test_stored_profiles_hold_what_the_readme_says():
