@@ -262,3 +262,19 @@ def test_resume_where_there_is_no_trial_is_one_line_and_creates_nothing(tmp_path
         assert list(out.iterdir()) == []
     else:
         assert out.read_text() == "x"
+
+
+def test_a_trial_stored_with_a_bad_setting_is_refused_in_one_line(short_trial, capsys):
+    """A config.json edited by hand (or written before the checks): eval and resume refuse it."""
+    config = storage.read_json(short_trial / CONFIG_FILE)
+    config["world"]["catch_rule"] = "held_stik"
+    storage.write_json(short_trial / CONFIG_FILE, config)
+    before = {p.name: p.read_bytes() for p in short_trial.iterdir() if p.is_file()}
+    for argv in (
+        ["eval", str(short_trial), "--quiet"],
+        ["run", "--out", str(short_trial), "--resume"],
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "catch_rule" in err and "held_stik" in err, err
+    assert {p.name: p.read_bytes() for p in short_trial.iterdir() if p.is_file()} == before
