@@ -59,6 +59,11 @@ class TrialError(Exception):
     """A trial directory or setting that cannot be used; the message says why."""
 
 
+class TrialConfigError(TrialError, ValueError):
+    """A config.json no trial can be made from: a TrialError (one line, exit code 2) and a
+    ValueError, as the configs raise for it (callers catching either keep working)."""
+
+
 class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
@@ -99,8 +104,8 @@ def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
 
 
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
-    """The agent and room of a trial's iteration 0, as its config makes them. TrialError (one
-    line) for a config that makes none: a config.json edited by hand, or written before the
+    """The agent and room of a trial's iteration 0, as its config makes them. TrialConfigError
+    (one line) for a config that makes none: a config.json edited by hand, or written before the
     configs checked their settings."""
     try:
         settings = config["trial"]
@@ -115,7 +120,7 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
             np.random.default_rng([settings["seed"], AGENT_STREAM]),
         )
     except (KeyError, TypeError, ValueError) as exc:
-        raise TrialError(f"{CONFIG_FILE} makes no trial: {exc}") from None
+        raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
     return agent, room
 
 
