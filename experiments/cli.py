@@ -10,11 +10,13 @@ from collections import Counter
 import numpy as np
 
 from experiments.cli_args import (
+    RUN_DEFAULTS,
     Parser,
     UsageError,
     iteration_list,
     non_negative_int,
     positive_int,
+    run_default,
     stored_profiles,
 )
 
@@ -46,17 +48,16 @@ def cmd_run(args: argparse.Namespace) -> None:
     """One trial of Model Babbling, written to a directory that survives being killed."""
     from experiments import storage
     from experiments.trial import TrialError, TrialSettings, run_trial
+    from experiments.trial_settings import resume_settings
 
+    # Options left out are None: a new trial takes the documented defaults, a resumed one
+    # its own settings, which those given must match.
+    given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
     try:
-        settings = TrialSettings(
-            grasp=args.grasp,
-            iterations=args.iterations,
-            seed=args.seed,
-            babbling=args.babbling,
-            checkpoint_every=args.checkpoint_every,
-            stick_return=args.stick_return,
-            preset=args.preset,
-        )
+        if args.resume:
+            settings = resume_settings(args.out, given)
+        else:
+            settings = TrialSettings(**{**RUN_DEFAULTS, **given})
         trial = run_trial(
             args.out,
             settings,
@@ -68,7 +69,7 @@ def cmd_run(args: argparse.Namespace) -> None:
         raise UsageError(str(exc)) from None
     c = trial.counts
     print(
-        f"{args.out}: {trial.iteration} iterations ({args.grasp}, seed {args.seed}); "
+        f"{args.out}: {trial.iteration} iterations ({settings.grasp}, seed {settings.seed}); "
         f"tool uses {c['tool_uses']}, words recognised {c['words_recognised']}, "
         f"stick returns {c['stick_returns']}, diverged {c['diverged']}"
     )
@@ -282,26 +283,35 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_random)
 
     p = sub.add_parser("run", help="one trial of Model Babbling into a directory")
-    p.add_argument("--grasp", choices=["kinematic", "physical"], default="kinematic")
-    p.add_argument("--iterations", type=positive_int, default=80000)
-    p.add_argument("--seed", type=non_negative_int, default=0)
+    # No argparse defaults: a setting left out is the default below for a new trial, and the
+    # trial's own (config.json) with --resume, where a setting given must match it.
+    p.add_argument("--grasp", choices=["kinematic", "physical"], help=run_default("grasp"))
+    p.add_argument(
+        "--iterations",
+        type=positive_int,
+        help=run_default("iterations", " (a larger number extends it)"),
+    )
+    p.add_argument("--seed", type=non_negative_int, help=run_default("seed"))
     p.add_argument("--out", required=True, help="the trial directory")
-    p.add_argument("--babbling", choices=["random", "active"], default="random")
-    p.add_argument("--checkpoint-every", type=positive_int, default=1000, metavar="K")
+    p.add_argument("--babbling", choices=["random", "active"], help=run_default("babbling"))
+    p.add_argument(
+        "--checkpoint-every", type=positive_int, metavar="K", help=run_default("checkpoint_every")
+    )
     p.add_argument(
         "--stick-return",
         choices=["out_of_reach", "never"],
-        default="out_of_reach",
-        help="the experimenter returns a stick beyond reach (default), or never (the study)",
+        help="the experimenter returns a stick beyond reach, or never (the study); "
+        + run_default("stick_return"),
     )
     p.add_argument(
         "--preset",
         choices=["study", "project"],
-        default="study",
-        help="world and learner as the study's code behaved (default), or the project's "
-        "earlier choices (docs/protocol.md §11)",
+        help="world and learner as the study's code behaved, or the project's earlier choices "
+        "(docs/protocol.md §11); " + run_default("preset"),
     )
-    p.add_argument("--resume", action="store_true", help="continue the trial in --out")
+    p.add_argument(
+        "--resume", action="store_true", help="continue the trial in --out as configured"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
 

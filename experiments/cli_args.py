@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 from importlib import resources
+from typing import Any
 
 
 def stored_profiles() -> list[str]:
@@ -11,6 +12,24 @@ def stored_profiles() -> list[str]:
     folder = resources.files("experiments").joinpath("profiles")
     names = (f.name for f in folder.iterdir())
     return sorted(name.removesuffix(".json") for name in names if name.endswith(".json"))
+
+
+# What `playroom run` does when a setting is left out of a new trial (a resumed one keeps its
+# own: experiments/trial_settings.py). TrialSettings' own defaults are those of short trials.
+RUN_DEFAULTS: dict[str, Any] = {
+    "grasp": "kinematic",
+    "iterations": 80000,
+    "seed": 0,
+    "babbling": "random",
+    "checkpoint_every": 1000,
+    "stick_return": "out_of_reach",
+    "preset": "study",
+}
+
+
+def run_default(name: str, more: str = "") -> str:
+    """Help of a `run` option: its default for a new trial (a resumed trial keeps its own)."""
+    return f"default: {RUN_DEFAULTS[name]}; with --resume: the trial's own{more}"
 
 
 class UsageError(Exception):

@@ -12,7 +12,8 @@ a random command) acts on the very same placements: normalised competence is
 Every test starts from the same scene: the stick at its start place, the toys at the placement,
 a seeded caregiver position. The trial's own files are read, never written, except the
 evaluation's outputs (`eval.json`, `competence.parquet`, `vocal.parquet`); eval.json names the
-machine it was computed on (`evaluated_on`, experiments/provenance.py).
+machine it was computed on (`evaluated_on`, experiments/provenance.py). eval.json is standard
+JSON: a number that is not finite (a best distance before any voice movement) is null.
 """
 
 from __future__ import annotations
@@ -222,7 +223,10 @@ def evaluate_trial(
         storage.write_table(trial_dir / COMPETENCE_FILE, competence)
         storage.write_table(trial_dir / VOCAL_FILE, vocal)
         storage.write_table(trial_dir / STUDY_TESTS_FILE, study)
-        storage.write_json(trial_dir / EVAL_FILE, summary)
+        # A word's best distance (and so a median) is infinite until the trial's first voice
+        # movement: eval.json, standard JSON, holds null for it (experiments/results.py reads
+        # it back as infinity). The summary returned keeps the numbers.
+        storage.write_json(trial_dir / EVAL_FILE, storage.finite_or_null(summary))
     finally:
         lock.release()
     return summary

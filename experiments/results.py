@@ -248,13 +248,18 @@ def _eval_numbers(trial_dir: Path, summary: dict) -> dict[str, float]:
             "mean_error": summary["mean_error"],
             "mean_random_error": summary["mean_random_error"],
             "share_below_threshold": vocal["share_below_threshold"],
-            "median_names": vocal["median_names"],
-            "median_distractors": vocal["median_distractors"],
+            # null: no voice movement, so no finite distance (experiments/evaluation.py).
+            "median_names": _distance(vocal["median_names"]),
+            "median_distractors": _distance(vocal["median_distractors"]),
         }
     except (KeyError, TypeError) as exc:
         raise ReportError(
             f"{trial_dir / EVAL_FILE} lacks {exc}: evaluate the trial again (`playroom eval`)"
         ) from None
+
+
+def _distance(value: float | None) -> float:
+    return math.inf if value is None else value
 
 
 def _timing(trial_dir: Path) -> tuple[float, float]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import os
 import re
 import zipfile
@@ -46,7 +47,22 @@ def write_bytes(path: Path, data: bytes) -> None:
 
 
 def write_json(path: Path, obj: Any) -> None:
-    write_bytes(path, (json.dumps(obj, indent=2, sort_keys=True) + "\n").encode())
+    """Standard JSON only: a NaN or infinity is a ValueError, never a non-standard `NaN` in a
+    file other tools cannot read (a writer with such numbers says what they mean: see
+    `finite_or_null`)."""
+    text = json.dumps(obj, indent=2, sort_keys=True, allow_nan=False)
+    write_bytes(path, (text + "\n").encode())
+
+
+def finite_or_null(obj: Any) -> Any:
+    """`obj` with every float that is NaN or infinite replaced by None (JSON null), nested."""
+    if isinstance(obj, dict):
+        return {k: finite_or_null(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [finite_or_null(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
 
 
 def write_text(path: Path, text: str) -> None:

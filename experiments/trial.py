@@ -13,14 +13,10 @@ moved aside into `stale-at-NNNNNNNN/`.
 
 from __future__ import annotations
 
-import dataclasses
-import json
 import os
 import shutil
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
@@ -51,78 +47,12 @@ from experiments.trial_files import (  # noqa: F401 (the trial's files are read 
     read_log,
     trial_identity,
 )
-from learner.config import LearnerConfig, learner_preset
+from experiments.trial_settings import (  # noqa: F401 (a trial's settings are read from here too)
+    TrialSettings,
+    full_config,
+)
 from models.layout import TOYS, block_slice
-from sim.config import PRESETS, WorldConfig, world_preset
-from sim.experimenter import STICK_RETURNS
-from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.words import word_distances
-
-
-@dataclass(frozen=True)
-class TrialSettings:
-    """What a user chooses for one trial (`playroom run`)."""
-
-    grasp: str = "kinematic"
-    iterations: int = 1000
-    seed: int = 0
-    babbling: str = "random"
-    checkpoint_every: int = 1000
-    stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
-    # "study": the world and learner as the study's code behaved; "project": this project's
-    # earlier choices (sim.config.world_preset, learner.config.learner_preset).
-    preset: str = "study"
-    # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
-    # departure switched at a time (ablations, docs/replication.md).
-    overrides: dict = dataclasses.field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        if self.grasp not in ("kinematic", "physical"):
-            raise TrialError(f"unknown grasp {self.grasp!r}: 'kinematic' or 'physical'")
-        if self.preset not in PRESETS:
-            raise TrialError(f"unknown preset {self.preset!r}: one of {', '.join(PRESETS)}")
-        unknown = sorted(set(self.overrides) - {"world", "learner"})
-        if unknown:
-            raise TrialError(f"overrides of unknown sections {unknown}: 'world' or 'learner'")
-        if self.stick_return not in STICK_RETURNS:
-            raise TrialError(
-                f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
-            )
-        for name in ("iterations", "checkpoint_every"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-                raise TrialError(f"{name} must be a positive integer, got {value!r}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise TrialError(f"seed must be a non-negative integer, got {self.seed!r}")
-
-
-def full_config(
-    settings: TrialSettings,
-    world: WorldConfig | None = None,
-    voice: VoiceConfig = DEFAULT_VOICE,
-    learner: LearnerConfig | None = None,
-) -> dict:
-    """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
-    the trial's room and agent from."""
-    changes = settings.overrides
-    try:
-        learner = learner or learner_preset(
-            settings.preset, **{"babbling": settings.babbling, **changes.get("learner", {})}
-        )
-        world = world or world_preset(
-            settings.preset, **{"stick_return": settings.stick_return, **changes.get("world", {})}
-        )
-    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
-        raise TrialError(f"overrides do not fit the configs: {exc}") from None
-    config = {
-        "trial": dataclasses.asdict(settings),
-        "world": dataclasses.asdict(world),
-        "voice": dataclasses.asdict(voice),
-        "learner": learner.to_dict(),
-        "package_version": version("playroom"),
-    }
-    # Through JSON and back, so that it compares equal to what config.json holds.
-    return json.loads(json.dumps(config))
 
 
 class Trial:

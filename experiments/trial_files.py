@@ -78,6 +78,11 @@ class TrialError(Exception):
     """A trial directory or setting that cannot be used; the message says why."""
 
 
+class TrialConfigError(TrialError, ValueError):
+    """A config.json no trial can be made from: a TrialError (one line, exit code 2) and a
+    ValueError, as the configs raise for it (callers catching either keep working)."""
+
+
 class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
@@ -118,18 +123,23 @@ def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
 
 
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
-    """The agent and room of a trial's iteration 0, as its config makes them."""
-    settings = config["trial"]
-    room = Playroom(
-        grasp=settings["grasp"],
-        seed=settings["seed"],
-        config=config_from_dict(WorldConfig, config["world"]),
-        voice=config_from_dict(VoiceConfig, config["voice"]),
-    )
-    agent = Agent(
-        LearnerConfig.from_dict(config["learner"]),
-        np.random.default_rng([settings["seed"], AGENT_STREAM]),
-    )
+    """The agent and room of a trial's iteration 0, as its config makes them. TrialConfigError
+    (one line) for a config that makes none: a config.json edited by hand, or written before the
+    configs checked their settings."""
+    try:
+        settings = config["trial"]
+        room = Playroom(
+            grasp=settings["grasp"],
+            seed=settings["seed"],
+            config=config_from_dict(WorldConfig, config["world"]),
+            voice=config_from_dict(VoiceConfig, config["voice"]),
+        )
+        agent = Agent(
+            LearnerConfig.from_dict(config["learner"]),
+            np.random.default_rng([settings["seed"], AGENT_STREAM]),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
     return agent, room
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from models import layout
+from models.checks import check_bool, check_choice, check_int, check_number
 
 BABBLING_MODES = ("random", "active")
 IMITATION_DRAWS = ("distinct", "heard")
@@ -74,49 +75,34 @@ class LearnerConfig:
     outcomes_to_infer: int = 1
 
     def __post_init__(self) -> None:
+        """Every field checked when the config is built (ValueError, one line naming the
+        field and what it allows): JSON types are not coerced, numbers must be finite."""
+        c = "LearnerConfig."
         for name in ("progress_window", "imitation_memory", "outcomes_to_infer"):
-            value = getattr(self, name)
-            if not isinstance(value, int) or isinstance(value, bool) or value <= 0:
-                raise ValueError(f"LearnerConfig.{name} must be a positive integer, got {value!r}")
+            check_int(c + name, getattr(self, name), minimum=1)
         for name in ("bootstrap_arm", "bootstrap_voice"):
-            value = getattr(self, name)
-            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-                raise ValueError(
-                    f"LearnerConfig.{name} must be a non-negative integer, got {value!r}"
-                )
+            check_int(c + name, getattr(self, name), minimum=0)
         for low, high in (("motor_low", "motor_high"), ("goal_low", "goal_high")):
-            lo, hi = getattr(self, low), getattr(self, high)
-            if not (_finite(lo) and _finite(hi) and lo < hi):
+            check_number(c + low, getattr(self, low))
+            check_number(c + high, getattr(self, high))
+            if not getattr(self, low) < getattr(self, high):
                 raise ValueError(
-                    f"LearnerConfig.{low} < {high} must be finite with {low} < {high}, "
-                    f"got {lo!r}, {hi!r}"
+                    f"{c}{low} must be below {c}{high}, got {getattr(self, low)!r} >= "
+                    f"{getattr(self, high)!r}"
                 )
         for name in ("exploration_sigma", "change_tolerance"):
-            value = getattr(self, name)
-            if not (_finite(value) and value >= 0):
-                raise ValueError(f"LearnerConfig.{name} must be finite and >= 0, got {value!r}")
+            check_number(c + name, getattr(self, name), "[0, inf)")
         for name in ("active_random_share", "imitation_share"):
-            value = getattr(self, name)
-            if not (_finite(value) and 0.0 <= value <= 1.0):
-                raise ValueError(f"LearnerConfig.{name} must be in [0, 1], got {value!r}")
-        if self.babbling not in BABBLING_MODES:
-            raise ValueError(
-                f"LearnerConfig.babbling must be one of {BABBLING_MODES}, got {self.babbling!r}"
-            )
+            check_number(c + name, getattr(self, name), "[0, 1]")
         for name, choices in (
+            ("babbling", BABBLING_MODES),
+            ("imitation_draw", IMITATION_DRAWS),
             ("imitation_pool", IMITATION_POOLS),
             ("bootstrap", BOOTSTRAPS),
             ("storing_rule", STORING_RULES),
         ):
-            if getattr(self, name) not in choices:
-                raise ValueError(
-                    f"LearnerConfig.{name} must be one of {choices}, got {getattr(self, name)!r}"
-                )
-        if self.imitation_draw not in IMITATION_DRAWS:
-            raise ValueError(
-                f"LearnerConfig.imitation_draw must be one of {IMITATION_DRAWS}, "
-                f"got {self.imitation_draw!r}"
-            )
+            check_choice(c + name, getattr(self, name), choices)
+        check_bool(c + "clip_sensory", self.clip_sensory)
 
     @property
     def n_bootstrap(self) -> int:
@@ -136,10 +122,6 @@ class LearnerConfig:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), sort_keys=True)
-
-
-def _finite(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and abs(value) < 1e308
 
 
 DEFAULT_LEARNER = LearnerConfig()

@@ -13,6 +13,22 @@ import math
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+from models.checks import (
+    check_choice,
+    check_int,
+    check_number,
+    check_numbers,
+    is_number,
+    tuples,
+)
+
+# The allowed values of the world's choices. sim/dmp.py and sim/experimenter.py, which apply
+# them, import them from here, so that a config is checked without importing either.
+DMP_KINDS = ("study", "project")  # sim/dmp.py
+CATCH_RULES = ("study", "held_stick")  # sim/grasp.py, sim/kinematic_movement.py
+STICK_RETURNS = ("never", "out_of_reach")  # sim/experimenter.py
+N_RINGS = 3  # the study's rings; evaluations and reports name them ring1..ring3
+
 
 @dataclass(frozen=True)
 class WorldConfig:
@@ -42,10 +58,45 @@ class WorldConfig:
     # iterations ("out_of_reach"), or never, as in the study (sim/experimenter.py, §11).
     stick_return: str = "out_of_reach"
 
+    def __post_init__(self) -> None:
+        """Every field checked when the config is built (ValueError, one line): a typo or a
+        number out of range is refused before a trial is written, never run as something else."""
+        for name in ("segment_lengths", "stick_start_handle", "toy_rings"):
+            object.__setattr__(self, name, tuples(getattr(self, name)))  # JSON gives lists
+        w = "WorldConfig."
+        check_numbers(w + "segment_lengths", self.segment_lengths, 3, "(0, inf)")
+        check_number(w + "arm_rest_offset", self.arm_rest_offset)
+        check_choice(w + "dmp", self.dmp, DMP_KINDS)
+        check_number(w + "dmp_weight_scale", self.dmp_weight_scale, "(0, inf)")
+        check_number(w + "stick_length", self.stick_length, "(0, inf)")
+        check_numbers(w + "stick_start_handle", self.stick_start_handle, 2)
+        check_number(w + "stick_start_angle", self.stick_start_angle)
+        check_int(w + "toy_replace_period", self.toy_replace_period, minimum=1)
+        _check_rings(w + "toy_rings", self.toy_rings)
+        for name in ("caregiver_box", "grasp_distance", "catch_distance"):
+            check_number(w + name, getattr(self, name), "(0, inf)")
+        check_choice(w + "catch_rule", self.catch_rule, CATCH_RULES)
+        check_number(w + "caregiver_bring_rate", self.caregiver_bring_rate, "(0, 1]")
+        check_choice(w + "stick_return", self.stick_return, STICK_RETURNS)
+
     @property
     def arm_length(self) -> float:
         """Reach of the hand from the arm's base (m)."""
         return float(sum(self.segment_lengths))
+
+
+def _check_rings(name: str, rings: Any) -> None:
+    """N_RINGS (low, high) pairs of distances from the arm's base, 0 <= low < high."""
+
+    def ring_ok(ring: Any) -> bool:
+        pair = isinstance(ring, tuple) and len(ring) == 2 and all(is_number(v) for v in ring)
+        return pair and 0 <= ring[0] < ring[1]
+
+    if not (isinstance(rings, tuple) and len(rings) == N_RINGS and all(map(ring_ok, rings))):
+        raise ValueError(
+            f"{name} must be {N_RINGS} [low, high] pairs of finite distances with "
+            f"0 <= low < high, got {rings!r}"
+        )
 
 
 DEFAULT_WORLD = WorldConfig()
@@ -74,10 +125,4 @@ def config_from_dict(cls: type[Config], values: dict[str, Any]) -> Config:
     unknown = sorted(set(values) - known)
     if unknown:
         raise ValueError(f"unknown {cls.__name__} fields: {', '.join(unknown)}")
-    return cls(**{k: _tuples(v) for k, v in values.items()})
-
-
-def _tuples(value: Any) -> Any:
-    if isinstance(value, list):
-        return tuple(_tuples(v) for v in value)
-    return value
+    return cls(**{k: tuples(v) for k, v in values.items()})

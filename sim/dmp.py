@@ -25,7 +25,7 @@ from models.layout import (
     N_STEPS,
     VOICE_BASIS_FUNCTIONS,
 )
-from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.config import DEFAULT_WORLD, DMP_KINDS, WorldConfig
 
 # Spring-damper gains of the transformation system, critically damped (beta = alpha / 4).
 ALPHA_Y = 25.0
@@ -86,9 +86,6 @@ def _integrate_study(
         y = y + gain * (end - y) + STUDY_DT**2 * forcing[k]
         out[k] = y
     return out.T
-
-
-DMP_KINDS = ("study", "project")
 
 
 @functools.lru_cache(maxsize=8)

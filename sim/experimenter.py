@@ -22,17 +22,12 @@ from sim.physics import PlayroomPhysics
 # Toys placed in the physical backend keep this clearance from each other and the stick (m):
 # two solid objects cannot share a place, and overlapping geoms would be pushed apart violently.
 PLACEMENT_CLEARANCE = 0.01
-STICK_RETURNS = ("never", "out_of_reach")
 
 
 class Experimenter:
     """Places the toys of a room, and returns its stick when the config says so."""
 
     def __init__(self, config: WorldConfig, physics: PlayroomPhysics, solid: bool) -> None:
-        if config.stick_return not in STICK_RETURNS:
-            raise ValueError(
-                f"unknown stick_return {config.stick_return!r}: choose one of {STICK_RETURNS}"
-            )
         self.config = config
         self.physics = physics
         self.solid = solid  # physical objects: placements keep clear of each other

@@ -39,6 +39,14 @@ def client():
     cluster.close()
 
 
+def _wait_for(path: Path, polls: int = 2400) -> None:
+    """Poll (every 50 ms, at most `polls` times) until `path` exists; no clock is read."""
+    for _ in range(polls):
+        if path.exists():
+            return
+        time.sleep(0.05)
+
+
 def _wait_for_first_checkpoint(trial_dir: Path, polls: int = 2400) -> None:
     """Poll (every 50 ms, at most `polls` times) until the trial has a checkpoint past
     iteration 0 (a run writes one at 0 before it starts); no clock is read."""
