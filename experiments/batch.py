@@ -15,6 +15,7 @@ import dataclasses
 import json
 import logging
 import os
+import threading
 import time
 from dataclasses import dataclass, field
 from importlib import resources
@@ -138,6 +139,10 @@ def is_complete(trial_dir: Path) -> bool:
 def run_and_evaluate(trial_dir: str, settings: TrialSettings, eval_placements: int) -> dict:
     """One batch task: run or resume the trial, then evaluate it. Safe to run again."""
     path = Path(trial_dir)
+    # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
+    # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
+    # the batch's last line. A worker draws no bar; a thread lock is enough.
+    tqdm.set_lock(threading.RLock())
     # Dask may run a task again while its first attempt still runs on a worker it lost touch
     # with: the second waits for the first to end instead of writing beside it.
     lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
@@ -228,25 +233,30 @@ def run_batch(
             ): name
             for name, settings in todo
         }
-        bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
-        if skipped and progress:
-            bar.write(f"skipping {skipped} complete trial(s)")
-        for future in as_completed(futures):
-            name = futures[future]
-            try:
-                results[name] = future.result()
-            except Exception as exc:  # a trial's error must not stop the others
-                failures[name] = f"{type(exc).__name__}: {exc}"
-            bar.update(1)
-            # Dask may queue more tasks on a worker than it has threads: at most one task per
-            # thread runs, the rest of the unfinished ones wait.
-            unfinished = sum(not f.done() for f in futures)
-            running = min(unfinished, sum(client.nthreads().values()))
-            waiting = unfinished - running
-            bar.set_postfix(
-                done=len(results), running=running, waiting=waiting, failed=len(failures)
-            )
-        bar.close()
+        # `with`: the bar's line is ended however the batch ends (Ctrl-C, SIGTERM).
+        with tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial") as bar:
+            if skipped and progress:
+                bar.write(f"skipping {skipped} complete trial(s)")
+            for future in as_completed(futures):
+                name = futures[future]
+                try:
+                    results[name] = future.result()
+                except Exception as exc:  # a trial's error must not stop the others
+                    failures[name] = f"{type(exc).__name__}: {exc}"
+                bar.update(1)
+                # Dask may queue more tasks on a worker than it has threads: at most one task per
+                # thread runs, the rest of the unfinished ones wait.
+                unfinished = sum(not f.done() for f in futures)
+                running = min(unfinished, sum(client.nthreads().values()))
+                waiting = unfinished - running
+                bar.set_postfix(
+                    done=len(results), running=running, waiting=waiting, failed=len(failures)
+                )
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (experiments/cli_faults.py)
+        # The workers' complaints about being closed mid-trial would follow the command's one
+        # line; their trials resume from their checkpoints.
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
     finally:
         if own_cluster is not None:
             client.close()
