@@ -30,7 +30,7 @@ from matplotlib.figure import Figure
 
 from experiments import storage
 from experiments.figures import STRATEGY_COLOURS, png_bytes
-from experiments.results import BatchResults, Geometry, ReportError, collect
+from experiments.results import BatchResults, Geometry, ReportError, check_out_dir, collect
 from experiments.statistics import STRATEGIES, mann_whitney, paired_difference, vocal_summary
 from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
 
@@ -86,7 +86,7 @@ def _row(
 ) -> AblationRow:
     results = results.select(group)
     trials = results.trials.sort_values("seed")
-    study = study_numbers(results, commands_per_ring, results.batch_dir).get(group)
+    study = study_numbers(results, commands_per_ring).get(group)
     vocal = results.vocal
     summary = vocal_summary(vocal, Geometry.of(results).threshold)
     names = vocal.loc[vocal["is_name"], "best_distance"]
@@ -270,15 +270,12 @@ def write_ablations(
     out_dir: str | os.PathLike,
     study_reference_commands: int = RANDOM_COMMANDS_PER_RING,
 ) -> Path:
-    """Compute the rows, then write the table, the CSV and the figure into out_dir (each
-    atomically, after everything was computed). Returns the table's path."""
+    """Compute the rows, then write the CSV, the figure and the table into out_dir as one unit
+    (after everything was computed; a failed write leaves nothing). Returns the table's path."""
+    check_out_dir(Path(out_dir))
     rows = ablation_rows(baseline_dir, batch_dirs, study_reference_commands)
     table = markdown_table(rows)
     figure = png_bytes(ablation_figure(rows))
     csv = csv_table(rows).to_csv(index=False)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    storage.write_text(out / CSV_FILE, csv)
-    storage.write_bytes(out / FIGURE_FILE, figure)
-    storage.write_text(out / TABLE_FILE, table)
-    return out / TABLE_FILE
+    files = {CSV_FILE: csv.encode(), FIGURE_FILE: figure, TABLE_FILE: table.encode()}
+    return storage.write_files(Path(out_dir), files)[-1]

@@ -14,8 +14,10 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 import os
 import sys
+import threading
 import time
 import uuid
 from collections.abc import Callable
@@ -64,6 +66,10 @@ def run_and_evaluate(
     """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
     for another writer of the trial is told to the client listening on `topic`."""
     path = Path(trial_dir)
+    # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
+    # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
+    # the batch's last line. A worker draws no bar; a thread lock is enough.
+    tqdm.set_lock(threading.RLock())
     # Dask may run a task again while its first attempt still runs on a worker it lost touch
     # with: the second waits for the first to end instead of writing beside it. So does a
     # task whose trial another batch or `playroom run` writes: the user hears of it.
@@ -185,6 +191,11 @@ def run_batch(
                 done=len(results), running=running, waiting=unfinished - running,
                 failed=len(failures),
             )  # fmt: skip
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (experiments/cli_faults.py)
+        # The workers' complaints about being closed mid-trial would follow the command's one
+        # line; their trials resume from their checkpoints.
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
     finally:
         bar.close()
         if own_cluster is not None:

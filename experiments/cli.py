@@ -1,4 +1,7 @@
-"""The `playroom` command line. Errors in what the user asked for exit with code 2 and one line."""
+"""The `playroom` command line. Every way a command ends but success is one line on stderr
+with an exit code: 2 for what the user asked (bad arguments, unusable directories), 1 for a
+fault of the machine (disk full, read-only file system), 130 for Ctrl-C (SIGINT) and 143 for
+SIGTERM, each line saying what was kept and how to resume (experiments/cli_faults.py)."""
 
 from __future__ import annotations
 
@@ -19,6 +22,7 @@ from experiments.cli_args import (
     run_default,
     stored_profiles,
 )
+from experiments.cli_faults import run_command
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -386,12 +390,7 @@ def main(argv: list[str] | None = None) -> int:
         from experiments import gl
 
         gl.without_rendering()
-    try:
-        args.func(args)
-    except UsageError as exc:
-        print(f"playroom {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    return 0
+    return run_command(args, sys.argv[1:] if argv is None else list(argv))
 
 
 if __name__ == "__main__":

@@ -30,7 +30,14 @@ from experiments.report_html import (
     where_table,
     write_page,
 )
-from experiments.results import COMPETENCE_SCOPES, BatchResults, Geometry, ReportError, collect
+from experiments.results import (
+    COMPETENCE_SCOPES,
+    BatchResults,
+    Geometry,
+    ReportError,
+    check_out_dir,
+    collect,
+)
 from experiments.statistics import (
     STRATEGIES,
     chi_square,
@@ -258,12 +265,11 @@ def write_comparison(
     `comparison.html` and `comparison-*.png` into out_dir; returns the page's path."""
     dir_a, dir_b = Path(dir_a), Path(dir_b)
     a, b = _sides(dir_a, dir_b)
+    check_out_dir(Path(out_dir))
     merged = a.merge(b)
     geometry = Geometry.of(merged)
     numbers = summarise(merged, geometry)
-    numbers["study"] = study_numbers(
-        merged, study_reference_commands, Path(out_dir), also_look_in=(dir_a, dir_b)
-    )
+    numbers["study"] = study_numbers(merged, study_reference_commands)
     published = paper.published()
     figures = [
         FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png)

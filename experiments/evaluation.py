@@ -28,7 +28,7 @@ from tqdm import tqdm
 
 from experiments import provenance, storage
 from experiments.lock import DirectoryLock, DirectoryLocked
-from experiments.trial import TrialLocked, load_trial
+from experiments.trial import TrialError, TrialLocked, load_trial
 from learner.agent import Agent
 from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
@@ -94,54 +94,58 @@ def competence_table(
     stick_start = (*room.config.stick_start_handle, room.config.stick_start_angle)
     rows = []
     total = len(room.config.toy_rings) * settings.n_placements * 3
-    bar = tqdm(total=total, disable=not progress, desc="evaluation", unit="test")
-    for ring_index, ring in enumerate(room.config.toy_rings, start=1):
-        toys_of = placements(ring, settings.n_placements, rng, room.min_toy_gap)
-        caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
-        for p in range(settings.n_placements):
-            room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])
-            scene = room.get_state()
-            context = room.context()
-            for toy in range(3):
-                goal = goal_trajectory(toys_of[p, toy])
-                block = block_slice(f"toy{toy + 1}")
-                arm_model, voice_model = agent.toy_models(toy + 1)
-                d_arm = agent.nearest_distance(arm_model, context, goal)
-                d_voice = agent.nearest_distance(voice_model, context, goal)
-                space, model = ("arm", arm_model) if d_arm <= d_voice else ("voice", voice_model)
-                untrained = not np.isfinite(min(d_arm, d_voice))
-                # A toy never moved has no model to invert: the arm stays at rest.
-                command = np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
-                feedback = room.act(space, command)
-                stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
-                stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
-                error = float(np.linalg.norm(feedback.s[block] - goal))
-                room.set_state(scene)
-                random_space = "arm" if rng.random() < 0.5 else "voice"
-                dim = MOTOR_DIMS[random_space]
-                random_fb = room.act(random_space, rng.uniform(-1, 1, dim))
-                random_error = float(np.linalg.norm(random_fb.s[block] - goal))
-                room.set_state(scene)
-                rows.append(
-                    {
-                        "ring": ring_index,
-                        "placement": p,
-                        "toy": toy + 1,
-                        "x": toys_of[p, toy, 0],
-                        "y": toys_of[p, toy, 1],
-                        "distance": float(np.linalg.norm(toys_of[p, toy])),
-                        "arm_nn_distance": d_arm,
-                        "voice_nn_distance": d_voice,
-                        "strategy": strategy_of(space, bool(stick_moved)),
-                        # A tool test either held the stick or only pushed it.
-                        "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
-                        "untrained": untrained,
-                        "error": error,
-                        "random_error": random_error,
-                    }
-                )
-                bar.update(1)
-    bar.close()
+    # `with`: the bar's line is ended however the evaluation ends (Ctrl-C, a fault).
+    with tqdm(total=total, disable=not progress, desc="evaluation", unit="test") as bar:
+        for ring_index, ring in enumerate(room.config.toy_rings, start=1):
+            toys_of = placements(ring, settings.n_placements, rng, room.min_toy_gap)
+            caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
+            for p in range(settings.n_placements):
+                room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])
+                scene = room.get_state()
+                context = room.context()
+                for toy in range(3):
+                    goal = goal_trajectory(toys_of[p, toy])
+                    block = block_slice(f"toy{toy + 1}")
+                    arm_model, voice_model = agent.toy_models(toy + 1)
+                    d_arm = agent.nearest_distance(arm_model, context, goal)
+                    d_voice = agent.nearest_distance(voice_model, context, goal)
+                    space, model = (
+                        ("arm", arm_model) if d_arm <= d_voice else ("voice", voice_model)
+                    )
+                    untrained = not np.isfinite(min(d_arm, d_voice))
+                    # A toy never moved has no model to invert: the arm stays at rest.
+                    command = (
+                        np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
+                    )
+                    feedback = room.act(space, command)
+                    stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
+                    stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
+                    error = float(np.linalg.norm(feedback.s[block] - goal))
+                    room.set_state(scene)
+                    random_space = "arm" if rng.random() < 0.5 else "voice"
+                    dim = MOTOR_DIMS[random_space]
+                    random_fb = room.act(random_space, rng.uniform(-1, 1, dim))
+                    random_error = float(np.linalg.norm(random_fb.s[block] - goal))
+                    room.set_state(scene)
+                    rows.append(
+                        {
+                            "ring": ring_index,
+                            "placement": p,
+                            "toy": toy + 1,
+                            "x": toys_of[p, toy, 0],
+                            "y": toys_of[p, toy, 1],
+                            "distance": float(np.linalg.norm(toys_of[p, toy])),
+                            "arm_nn_distance": d_arm,
+                            "voice_nn_distance": d_voice,
+                            "strategy": strategy_of(space, bool(stick_moved)),
+                            # A tool test either held the stick or only pushed it.
+                            "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
+                            "untrained": untrained,
+                            "error": error,
+                            "random_error": random_error,
+                        }
+                    )
+                    bar.update(1)
     return pd.DataFrame(rows)
 
 
@@ -197,7 +201,9 @@ def summarise(config: dict, competence: pd.DataFrame, vocal: pd.DataFrame) -> di
 def evaluate_trial(
     trial_dir: str | os.PathLike, settings: EvaluationSettings | None = None, progress=False
 ) -> dict:
-    """Evaluate a trial's final state and write eval.json and the tables beside it."""
+    """Evaluate a trial's final state and write eval.json and the tables beside it, as one
+    unit: a write that fails (disk full) leaves the trial's evaluation files as they were.
+    TrialError, before any work, for a directory that cannot be written (read-only)."""
     settings = settings or EvaluationSettings()
     trial_dir = Path(trial_dir)
     config, agent, room, meta = load_trial(trial_dir)
@@ -206,7 +212,13 @@ def evaluate_trial(
         lock = DirectoryLock(trial_dir).acquire()
     except DirectoryLocked as exc:
         raise TrialLocked(str(exc)) from None
+    except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
+        raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
     try:
+        try:  # before minutes of tests whose results could not be kept
+            storage.check_writable(trial_dir)
+        except OSError as exc:
+            raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
         final_state = room.get_state()  # the study's measure starts from it too
         competence = competence_table(agent, room, settings, progress=progress)
         vocal = vocal_table(meta["best_word_distance"], room.words.names)
@@ -220,13 +232,17 @@ def evaluate_trial(
 
         room.set_state(final_state)
         study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
-        storage.write_table(trial_dir / COMPETENCE_FILE, competence)
-        storage.write_table(trial_dir / VOCAL_FILE, vocal)
-        storage.write_table(trial_dir / STUDY_TESTS_FILE, study)
-        # A word's best distance (and so a median) is infinite until the trial's first voice
-        # movement: eval.json, standard JSON, holds null for it (experiments/results.py reads
-        # it back as infinity). The summary returned keeps the numbers.
-        storage.write_json(trial_dir / EVAL_FILE, storage.finite_or_null(summary))
+        # eval.json last: it vouches for the tables (storage.write_files). A word's best
+        # distance (and so a median) is infinite until the trial's first voice movement:
+        # eval.json, standard JSON, holds null for it (experiments/results.py reads it back as
+        # infinity). The summary returned keeps the numbers.
+        files = {
+            COMPETENCE_FILE: storage.table_bytes(competence),
+            VOCAL_FILE: storage.table_bytes(vocal),
+            STUDY_TESTS_FILE: storage.table_bytes(study),
+            EVAL_FILE: storage.json_bytes(storage.finite_or_null(summary)),
+        }
+        storage.write_files(trial_dir, files)
     finally:
         lock.release()
     return summary

@@ -4,8 +4,8 @@ batches side by side (`playroom compare DIR_A DIR_B --out DIR`, in `experiments.
 The work is split by job: `results` reads a batch directory into tables, `statistics`
 computes on them, `paper` holds the paper's published numbers, `figures` draws, and
 `report_html` renders the page from templates. Everything is computed and rendered in memory
-first and each file is then written atomically (`storage`), so a failing report leaves
-nothing half-written.
+first and the files are then written as one unit (`storage.write_files`), so a failing report
+(bad input, a full disk) leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from experiments import name_strategies, paper
 from experiments.comparison import COMPARISON_FILE, write_comparison
 from experiments.figures import report_figures
 from experiments.report_html import render, settings_table, trials_table, where_table, write_page
-from experiments.results import Geometry, ReportError, collect
+from experiments.results import Geometry, ReportError, check_out_dir, collect
 from experiments.statistics import summarise
 from experiments.study_figures import study_figure_files
 from experiments.study_measure import RANDOM_COMMANDS_PER_RING, study_numbers
@@ -38,9 +38,11 @@ def write_report(
     (one line) for a batch that cannot be reported on; nothing is written then.
     `study_reference_commands`: random commands per ring of the study's own measure."""
     results = collect(batch_dir)
+    out = Path(out_dir) if out_dir is not None else results.batch_dir
+    check_out_dir(out)
     geometry = Geometry.of(results)
     numbers = summarise(results, geometry)
-    numbers["study"] = study_numbers(results, study_reference_commands, results.batch_dir)
+    numbers["study"] = study_numbers(results, study_reference_commands)
     published = paper.published()
     figures = report_figures(results, geometry, published["competence_all"].value)
     figures += study_figure_files(results, published)
@@ -61,5 +63,4 @@ def write_report(
         where_note=where_note,
         **name_strategies.page_context(results, geometry.threshold),
     )
-    out = Path(out_dir) if out_dir is not None else results.batch_dir
     return write_page(out, figures, REPORT_FILE, page)

@@ -225,11 +225,9 @@ def render(template: str, **context: Any) -> str:
 
 
 def write_page(out_dir: Path, figures: list[FigureFile], page_name: str, page: str) -> Path:
-    """The PNGs, then the page last (each atomically): a page on disk means its figures are
-    there too. Returns the page's path."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    for figure in figures:
-        storage.write_bytes(out_dir / figure.name, figure.png)
-    target = out_dir / page_name
-    storage.write_text(target, page)
-    return target
+    """The PNGs and the page as one unit (`storage.write_files`), the page last: a write that
+    fails (disk full) leaves nothing, and a page on disk means its figures are there too.
+    Returns the page's path."""
+    files = {figure.name: figure.png for figure in figures}
+    files[page_name] = page.encode("utf-8")
+    return storage.write_files(out_dir, files)[-1]

@@ -25,7 +25,7 @@ from experiments import storage
 from experiments.curves import curve_rows, tool_numbers
 from experiments.evaluation import COMPETENCE_FILE, EVAL_FILE, STUDY_TESTS_FILE, VOCAL_FILE
 from experiments.provenance import SHORT_FIELDS, computed_on
-from experiments.trial import CONFIG_FILE, read_log
+from experiments.trial import CONFIG_FILE, LOG_DIR, read_log
 
 TIMING_FILE = "timing.json"
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
@@ -171,14 +171,25 @@ def _names(paths: list[Path], limit: int = 5) -> str:
     return shown + (f" and {len(paths) - limit} more" if len(paths) > limit else "")
 
 
+def _is_trial(directory: Path) -> bool:
+    """Whether a folder is a trial directory: `playroom run` writes its config.json and log/
+    (experiments/trial_files.py). Another tool's folder with a config.json is not one."""
+    return (directory / CONFIG_FILE).is_file() and (directory / LOG_DIR).is_dir()
+
+
 def _trial_dirs(batch_dir: Path) -> list[Path]:
     if not batch_dir.is_dir():
         raise ReportError(f"{batch_dir} is not a directory")
-    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and (d / CONFIG_FILE).exists())
+    if _is_trial(batch_dir):
+        raise ReportError(
+            f"{batch_dir} is a trial directory, not a batch: give the folder that holds trial "
+            f"directories (this one is in {batch_dir.resolve().parent})"
+        )
+    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and _is_trial(d))
     if not dirs:
         raise ReportError(
-            f"{batch_dir} holds no trials (no sub-directory with {CONFIG_FILE}); "
-            "run `playroom batch` or `playroom run` first"
+            f"no trial directories found in {batch_dir}: a batch directory holds one folder per "
+            f"trial (its {CONFIG_FILE} and {LOG_DIR}/), as `playroom batch --out DIR` writes them"
         )
     missing = [d for d in dirs if not (d / EVAL_FILE).exists()]
     if missing:
@@ -187,6 +198,14 @@ def _trial_dirs(batch_dir: Path) -> list[Path]:
             f"(not evaluated): {_names(missing)}; run `playroom eval` on them"
         )
     return dirs
+
+
+def check_out_dir(out_dir: Path) -> None:
+    """ReportError, before any work, if out_dir cannot be written (a read-only place, a file)."""
+    try:
+        storage.check_writable(out_dir)
+    except OSError as exc:
+        raise ReportError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
 
 
 def _group_label(grasp: str, babbling: str, mixed_babbling: bool) -> str:

@@ -1,8 +1,12 @@
 """Files of a trial directory, written atomically: a reader (or a run killed at any moment)
-sees either the old file or the new one, never half of one."""
+sees either the old file or the new one, never half of one. Files that belong together (a
+report's page and figures, an evaluation's tables and eval.json) are written as one unit
+(`write_files`). A write that fails raises `WriteError`, an OSError naming the file meant."""
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import io
 import json
 import math
@@ -31,27 +35,125 @@ def temporary_writer(name: str) -> int | None:
     return None if match is None else int(match["pid"])
 
 
-def write_bytes(path: Path, data: bytes) -> None:
-    """Write `data` to `path` atomically: through a temporary file beside it, then a rename."""
-    path = Path(path)
+class WriteError(OSError):
+    """A file that could not be written (disk full, read-only place): `filename` is the file
+    meant, not its temporary, and `strerror` the system's reason. Nothing of it was left."""
+
+
+def reason(exc: OSError) -> str:
+    """The system's reason for an OSError, for a message: "no space left on device"."""
+    text = exc.strerror or str(exc)
+    return text[:1].lower() + text[1:]
+
+
+def _write_temporary(path: Path, data: bytes) -> Path:
+    """`data` in a temporary file beside `path`, on disk (fsync); WriteError naming `path`."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         with open(tmp, "wb") as f:
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)  # a failed write (disk full, killed) leaves no litter
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)  # a failed write (disk full, killed) leaves no litter
+        if isinstance(exc, OSError):
+            raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from exc
         raise
+    return tmp
+
+
+def write_bytes(path: Path, data: bytes) -> None:
+    """Write `data` to `path` atomically: through a temporary file beside it, then a rename."""
+    path = Path(path)
+    tmp = _write_temporary(path, data)
+    try:
+        os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+
+
+def write_files(directory: Path, files: dict[str, bytes]) -> list[Path]:
+    """Files written into `directory` (created if missing) as one unit: each is first written
+    to a temporary file beside it, and only when all are on disk are they renamed into place,
+    in order. A write that fails (disk full, a read-only place, an interrupt) removes the
+    temporaries and the folders this call created: nothing is changed. The last file vouches
+    for the others (a page for its figures, eval.json for its tables): an older version of it
+    is removed before any other file is replaced, so that it is never found beside a mix of
+    old and new files. Returns the paths written, in order."""
+    directory = Path(directory)
+    created = [p for p in (directory, *directory.parents) if not p.exists()][::-1]
+    written: list[tuple[Path, Path]] = []
+    try:
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise WriteError(exc.errno, exc.strerror or str(exc), str(directory)) from exc
+        for name, data in files.items():
+            written.append((_write_temporary(directory / name, data), directory / name))
+    except BaseException:
+        for tmp, _ in written:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+        for folder in reversed(created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
+    replaced = 0
+    try:
+        if written:
+            written[-1][1].unlink(missing_ok=True)
+        for tmp, path in written:
+            os.replace(tmp, path)
+            replaced += 1
+    except BaseException as exc:  # after the writes, a rename failing is all but unheard of
+        for tmp, _ in written[replaced:]:
+            with contextlib.suppress(OSError):
+                tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            path = written[replaced][1]
+            raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+        raise
+    return [path for _, path in written]
+
+
+def check_writable(directory: Path) -> None:
+    """Raise WriteError (naming `directory`) unless a file can be created in it, before work
+    whose results would go there is done. A directory not made yet is checked where it would
+    be made: in its nearest existing parent."""
+    directory = Path(directory)
+    while not directory.exists() and directory != directory.parent:
+        directory = directory.parent
+    if not directory.is_dir():
+        raise WriteError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(directory))
+    probe = directory / f".write-test.{os.getpid()}"
+    try:
+        os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
+        os.unlink(probe)
+    except OSError as exc:
+        raise WriteError(exc.errno, exc.strerror or str(exc), str(directory)) from exc
+
+
+def json_bytes(obj: Any) -> bytes:
+    """`obj` as the JSON text every file of the project holds (indented, keys sorted, standard
+    JSON: a NaN or infinity is a ValueError)."""
+    return (json.dumps(obj, indent=2, sort_keys=True, allow_nan=False) + "\n").encode()
+
+
+def table_bytes(table: pd.DataFrame) -> bytes:
+    """`table` as Parquet (without its index)."""
+    buffer = io.BytesIO()
+    table.to_parquet(buffer, index=False)
+    return buffer.getvalue()
 
 
 def write_json(path: Path, obj: Any) -> None:
     """Standard JSON only: a NaN or infinity is a ValueError, never a non-standard `NaN` in a
     file other tools cannot read (a writer with such numbers says what they mean: see
     `finite_or_null`)."""
-    text = json.dumps(obj, indent=2, sort_keys=True, allow_nan=False)
-    write_bytes(path, (text + "\n").encode())
+    write_bytes(path, json_bytes(obj))
 
 
 def finite_or_null(obj: Any) -> Any:
@@ -85,6 +187,15 @@ def write_arrays(path: Path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     write_bytes(path, buffer.getvalue())
 
 
+def read_meta(path: Path) -> dict:
+    """The `meta` dict of a `write_arrays` file, without reading its arrays."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return json.loads(data["__meta__"].tobytes().decode())
+    except (zipfile.BadZipFile, ValueError, KeyError, OSError, EOFError) as exc:
+        raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+
+
 def read_arrays(path: Path) -> tuple[dict[str, np.ndarray], dict]:
     try:
         with np.load(path, allow_pickle=False) as data:
@@ -96,9 +207,7 @@ def read_arrays(path: Path) -> tuple[dict[str, np.ndarray], dict]:
 
 
 def write_table(path: Path, table: pd.DataFrame) -> None:
-    buffer = io.BytesIO()
-    table.to_parquet(buffer, index=False)
-    write_bytes(path, buffer.getvalue())
+    write_bytes(path, table_bytes(table))
 
 
 def read_table(path: Path) -> pd.DataFrame:

@@ -32,8 +32,10 @@ How the study's code measured (its scripts/run.py and analysis notebooks):
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +43,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import models
+import sim
 from experiments.evaluation import goal_trajectory, strategy_of
 from experiments.statistics import STRATEGIES
 from experiments.study_maps import (  # noqa: F401 (the maps are read from here too)
@@ -216,44 +220,92 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     return summary
 
 
+# Where played random references are kept between reports: this variable if set (tests,
+# clusters whose home is small or shared), else the user's cache directory.
+CACHE_ENV = "PLAYROOM_CACHE_DIR"
+
+
+def reference_cache_dir() -> Path:
+    """Where `study_numbers` keeps the random references it played: $PLAYROOM_CACHE_DIR, else
+    the user's cache directory (platformdirs: ~/.cache/playroom on Linux). Never a batch
+    directory: a report only reads its batches, which may be read-only or shared."""
+    override = os.environ.get(CACHE_ENV)
+    if override:
+        return Path(override)
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("playroom"))
+
+
+@functools.cache
+def _code_digest() -> str:
+    """A digest of what plays a reference (this module, the room's code, model and voice
+    data): a reference kept by another version of the project is not read back as this one's."""
+    digest = hashlib.sha256(Path(__file__).read_bytes())
+    for package in (sim, models):
+        folder = Path(package.__file__).parent
+        files = (p for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
+        for path in sorted(files):
+            digest.update(str(path.relative_to(folder)).encode() + path.read_bytes())
+    return digest.hexdigest()
+
+
+def _read_kept(path: Path) -> pd.DataFrame | None:
+    from experiments import storage
+
+    try:
+        return storage.read_table(path) if path.exists() else None
+    except storage.CorruptFileError:  # damaged (a cache is not kept with care): played again
+        return None
+
+
+def _keep(path: Path, reference: pd.DataFrame) -> None:
+    """Keep a played reference, if the cache can take it: a report never fails for its cache
+    (a full or read-only cache directory only means playing the reference again next time)."""
+    from experiments import storage
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        storage.write_table(path, reference)
+    except OSError:
+        pass
+
+
 def study_numbers(
     results,
     commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
     cache_dir: Path | None = None,
-    also_look_in: tuple[Path, ...] = (),
 ) -> dict[str, dict]:
     """`study_summary` of each group of a batch (`experiments.results.BatchResults`) whose
     trials hold the study's tests: their tests pooled over trials (the study averaged errors
     per pixel over its runs), against a random reference played in a fresh room of the
-    group's settings. The reference depends on the settings alone: with `cache_dir` it is kept
-    there (`study-reference-<digest>.parquet`) and read back by later reports, which also look
-    for it in `also_look_in` (a comparison reads what the batches' reports kept)."""
-    from experiments import storage
+    group's settings. The reference depends on the settings and the code alone: it is kept in
+    `cache_dir` (default: `reference_cache_dir()`) as `study-reference-<digest>.parquet` and
+    read back by later reports, comparisons and ablations of any batch of those settings."""
     from experiments.trial import fresh_trial_parts
 
+    cache = Path(cache_dir) if cache_dir is not None else reference_cache_dir()
     numbers = {}
     for group, config in results.configs.items():
         tests = results.study_tests[results.study_tests["group"] == group]
         if tests.empty:
             continue
         config = {**config, "trial": {**config["trial"], "seed": 0}}
-        key = json.dumps({"config": config, "commands": commands_per_ring}, sort_keys=True)
-        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
-        cached = (
-            None if cache_dir is None else Path(cache_dir) / f"study-reference-{digest}.parquet"
+        key = json.dumps(
+            {"config": config, "commands": commands_per_ring, "code": _code_digest()},
+            sort_keys=True,
         )
-        if cached is not None and cached.exists():
-            reference = storage.read_table(cached)
-        else:
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        cached = cache / f"study-reference-{digest}.parquet"
+        reference = _read_kept(cached)
+        if reference is None:
             try:
                 _, room = fresh_trial_parts(config)
             except ValueError:  # settings no room can be built from: the row says "not measured"
                 continue
             settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
             reference = random_reference(room, settings)
-            if cached is not None:
-                cached.parent.mkdir(parents=True, exist_ok=True)
-                storage.write_table(cached, reference)
+            _keep(cached, reference)
         numbers[group] = study_summary(tests, reference)
         numbers[group]["reference_commands_per_ring"] = commands_per_ring
     return numbers

@@ -13,6 +13,7 @@ moved aside into `stale-at-NNNNNNNN/`.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import time
@@ -130,7 +131,14 @@ class Trial:
         except OSError as exc:
             raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
         if not config_path.exists():
-            storage.write_json(config_path, self.config)
+            try:
+                storage.write_json(config_path, self.config)
+            except OSError:
+                # A new trial whose first file cannot be written (disk full) leaves its folder
+                # as it found it, so that the same command can start it later.
+                with contextlib.suppress(OSError):
+                    (d / LOG_DIR).rmdir()  # made just above; empty, or rmdir refuses
+                raise
 
     @property
     def finished(self) -> bool:
@@ -205,17 +213,18 @@ class Trial:
     def run(self, progress: bool = True) -> None:
         """Run until `iterations`, checkpointing every `checkpoint_every` iterations."""
         total = self.settings.iterations
-        bar = tqdm(
+        # `with`: the bar's line is ended however the run ends (Ctrl-C, disk full), before
+        # the command's last line.
+        with tqdm(
             total=total,
             initial=self.iteration,
             disable=not progress,
             unit="it",
             desc=f"{self.settings.grasp} seed {self.settings.seed}",
             dynamic_ncols=True,
-        )
-        self._run_to(total, bar)
-        bar.set_postfix(self.counts)
-        bar.close()
+        ) as bar:
+            self._run_to(total, bar)
+            bar.set_postfix(self.counts)
 
     def _run_to(self, total: int, bar: tqdm) -> None:
         """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""

@@ -12,6 +12,16 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import pytest  # noqa: E402
 
 
+@pytest.fixture(scope="session", autouse=True)
+def reference_cache(tmp_path_factory):
+    """Reports keep their played references in a folder of the session, not the user's cache
+    (experiments.study_measure.CACHE_ENV, named here so that nothing heavy is imported before
+    the tests choose; subprocesses inherit it)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("PLAYROOM_CACHE_DIR", str(tmp_path_factory.mktemp("reference-cache")))
+        yield
+
+
 @pytest.fixture(scope="session")
 def savez_round_trip():
     """state dict -> the same dict written by np.savez and read back, as checkpoints are."""

@@ -218,7 +218,7 @@ def _refused(batch: Path, tmp_path: Path, *words: str) -> None:
 
 def test_empty_directory_is_refused(tmp_path):
     (tmp_path / "empty").mkdir()
-    _refused(tmp_path / "empty", tmp_path, "holds no trials")
+    _refused(tmp_path / "empty", tmp_path, "no trial directories found")
 
 
 def test_trial_without_evaluation_is_named(batches, tmp_path):
@@ -365,9 +365,12 @@ def test_stick_numbers_of_a_hand_made_log():
 def test_the_study_reference_is_played_once_and_kept(batches, tmp_path, monkeypatch):
     from experiments import study_measure
 
+    monkeypatch.setenv(study_measure.CACHE_ENV, str(tmp_path / "cache"))
     batch = _copy_batch(batches, tmp_path / "batch")
     first = write_report(batch, tmp_path / "one", study_reference_commands=20).read_text()
-    assert len(list(batch.glob("study-reference-*.parquet"))) == 1
+    # Kept in the cache directory, not in the batch the report only reads.
+    assert len(list((tmp_path / "cache").glob("study-reference-*.parquet"))) == 1
+    assert not list(batch.glob("study-reference-*"))
 
     def played(*args, **kwargs):
         raise AssertionError("the kept reference should have been read back")

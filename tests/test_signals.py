@@ -1,0 +1,131 @@
+"""Ctrl-C (SIGINT) and SIGTERM end `playroom run` and `playroom batch` with one line saying
+how to resume, exit codes 130 and 143, the trial's lock released (experiments/cli_faults.py)."""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from experiments import cli_faults, storage
+from experiments.lock import DirectoryLock
+from experiments.trial import CHECKPOINT_FILE, read_log
+
+PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+REPO = Path(__file__).parent.parent
+
+
+def _checkpointed(trial: Path) -> int:
+    """The iteration of the trial's newest checkpoint (0 if none can be read yet)."""
+    try:
+        return storage.read_meta(trial / CHECKPOINT_FILE)["iteration"]
+    except (FileNotFoundError, storage.CorruptFileError):
+        return 0
+
+
+def _stop_after(command: list[str], trial: Path, past: int, signum: int, **popen) -> tuple:
+    """Start `command`, send `signum` once the trial has a checkpoint past iteration `past`;
+    (exit code, stderr)."""
+    proc = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, cwd=REPO, **popen)
+    for _ in range(1200):  # polls every 25 ms; no clock is read
+        if _checkpointed(trial) > past or proc.poll() is not None:
+            break
+        time.sleep(0.025)
+    if popen.get("start_new_session"):
+        os.killpg(proc.pid, signum)  # as a terminal or a job scheduler signals a whole job
+    else:
+        proc.send_signal(signum)
+    _, err = proc.communicate(timeout=60)
+    return proc.returncode, err
+
+
+def _lock_is_free(trial: Path) -> bool:
+    lock = DirectoryLock(trial).acquire()
+    lock.release()
+    return True
+
+
+def test_sigint_then_sigterm_end_a_run_with_one_line_and_it_resumes(tmp_path):
+    out = tmp_path / "trial"
+    args = ["run", "--out", str(out), "--iterations", "100000", "--checkpoint-every", "50"]
+    code, err = _stop_after([*PLAYROOM, *args, "--quiet"], out, 0, signal.SIGINT)
+    assert code == 130, err
+    first = _checkpointed(out)
+    line = err.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert line.startswith("playroom run: interrupted") and f"iteration {first}" in line
+    assert _lock_is_free(out)
+
+    # The command the line gives resumes the trial; SIGTERM stops it the same way.
+    resume = shlex.split(line.split("resume with: ")[1])
+    assert resume[0] == "playroom" and "--resume" in resume
+    code, err = _stop_after([*PLAYROOM, *resume[1:]], out, first, signal.SIGTERM)
+    assert code == 143, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "interrupted" in lines[0] and "--resume" in lines[0]
+    second = _checkpointed(out)
+    assert second > first
+    assert list(read_log(out)["iteration"]) == list(range(second))  # nothing lost or doubled
+
+
+def test_sigterm_ends_a_batch_with_one_line_saying_how_to_resume(tmp_path):
+    config = tmp_path / "batch.json"
+    config.write_text(
+        '{"grasps": ["kinematic"], "seeds": [0], "iterations": 100000, '
+        '"checkpoint_every": 50, "eval_placements": 1}'
+    )
+    out = tmp_path / "batch"
+    trial = out / "kinematic-random-seed0000"
+    command = [*PLAYROOM, "batch", "--config", str(config), "--out", str(out), "--workers", "1"]
+    code, err = _stop_after(command, trial, 0, signal.SIGTERM, start_new_session=True)
+    assert code == 143, err
+    assert "Traceback" not in err and "Warning" not in err
+    # The progress bar's lines come first, ended; the last line says how to go on.
+    last = err.rstrip("\n").split("\n")[-1]
+    assert last.startswith("playroom batch: interrupted")
+    assert f"rerun the same command to resume: playroom batch --config {config}" in last
+    assert _checkpointed(trial) > 0 and _lock_is_free(trial)
+
+
+# The handler itself, in this process -------------------------------------------------------------
+def _ended_by(failure: BaseException, capsys, command: str = "report") -> tuple[int, str]:
+    def func(args):
+        raise failure
+
+    args = argparse.Namespace(command=command, func=func, out="nowhere")
+    code = cli_faults.run_command(args, [command, "x"])
+    return code, capsys.readouterr().err
+
+
+def test_each_way_out_has_its_exit_code_and_one_line(capsys):
+    full = storage.WriteError(errno.ENOSPC, os.strerror(errno.ENOSPC), "/x/report.html")
+    code, err = _ended_by(full, capsys)
+    assert code == 1
+    assert err == (
+        "playroom report: error: cannot write /x/report.html: no space left on device; "
+        "nothing was written\n"
+    )
+    code, err = _ended_by(KeyboardInterrupt(), capsys)
+    assert (code, err) == (130, "playroom report: interrupted; nothing was written\n")
+    code, err = _ended_by(cli_faults.Terminated(), capsys, command="say")
+    assert (code, err) == (143, "playroom say: interrupted\n")
+    code, err = _ended_by(cli_faults.UsageError("bad"), capsys)
+    assert (code, err) == (2, "playroom report: error: bad\n")
+
+
+def test_sigterm_raises_in_the_block_and_the_handlers_are_restored():
+    before = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    with pytest.raises(cli_faults.Terminated):
+        with cli_faults.signals_as_exceptions():
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):  # the handler runs at the next bytecode boundaries
+                time.sleep(0.001)
+    assert (signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)) == before
