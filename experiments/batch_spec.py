@@ -16,7 +16,7 @@ from experiments.cli_args import stored_profiles
 from experiments.trial import TrialError, TrialSettings, full_config
 from learner.config import BABBLING_MODES
 from sim.config import PRESETS
-from sim.experimenter import STICK_RETURNS
+from sim.config import STICK_RETURNS
 
 
 class BatchError(Exception):

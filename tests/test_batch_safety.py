@@ -45,7 +45,7 @@ TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_ev
         ({"preset": 1}, "preset must be one of study, project"),
         ({"overrides": []}, "overrides must be an object"),
         ({"overrides": {"sky": {}}}, "overrides must be an object"),
-        ({"overrides": {"world": {"no_such_setting": 1}}}, "overrides do not fit"),
+        ({"overrides": {"world": {"no_such_setting": 1}}}, "unknown settings no_such_setting"),
         ({"description": 5}, "description must be a string"),
         ({"sede": 3}, "unknown field(s) sede"),
         ([{"seeds": 2}], "must hold a JSON object"),
