@@ -59,6 +59,10 @@ def _random_commands(rng: np.random.Generator, n: int) -> list[tuple[str, np.nda
     return commands
 
 
+# 2000 commands a preset (about 15 s each on 2 cores): the quick suite keeps the scripted
+# scenes below and the kinematic reference trial (tests/test_reference_logs.py), which runs
+# the closed form for 2000 iterations; `make test-slow` runs these.
+@pytest.mark.slow
 @pytest.mark.parametrize("config", [DEFAULT_WORLD, STUDY_WORLD], ids=["project", "study"])
 def test_kinematic_whole_movements_equal_the_stepped_rules_on_random_commands(config):
     fast, stepped = _twin_rooms("kinematic", seed=5, config=config)

@@ -19,7 +19,8 @@ from experiments import cli_faults, storage
 from experiments.lock import DirectoryLock
 from experiments.trial import CHECKPOINT_FILE, read_log
 
-PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+# -X faulthandler: a run that outlives its signal shows where it was (SIGABRT below).
+PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli"]
 REPO = Path(__file__).parent.parent
 
 
@@ -43,7 +44,12 @@ def _stop_after(command: list[str], trial: Path, past: int, signum: int, **popen
         os.killpg(proc.pid, signum)  # as a terminal or a job scheduler signals a whole job
     else:
         proc.send_signal(signum)
-    _, err = proc.communicate(timeout=60)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGABRT)
+        _, err = proc.communicate()
+        raise AssertionError(f"still running 60 s after signal {signum}:\n{err}") from None
     return proc.returncode, err
 
 

@@ -68,7 +68,7 @@ def _checkpointed_iteration(trial_dir: Path) -> int:
     [("kinematic", 4), pytest.param("physical", 5, marks=pytest.mark.slow)],
 )
 def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path, grasp, seed):
-    total, period = 3000, 200
+    total, period = 1500, 100
     args = ["run", "--grasp", grasp, "--iterations", str(total), "--seed", "4"]
     args += ["--checkpoint-every", str(period), "--quiet"]
     whole = tmp_path / "whole"
