@@ -15,8 +15,7 @@ from pathlib import Path
 from experiments.cli_args import stored_profiles
 from experiments.trial import TrialError, TrialSettings, full_config
 from learner.config import BABBLING_MODES
-from sim.config import PRESETS
-from sim.config import STICK_RETURNS
+from sim.config import PRESETS, STICK_RETURNS
 
 
 class BatchError(Exception):
