@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -45,8 +46,8 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
     assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
     assert "experiments/profiles/demo.json" in names
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
-    for tool in ("pytest", "ruff"):
-        (line,) = [r for r in requires if r.split()[1].startswith(tool)]
+    for tool in ("pytest", "pytest-xdist", "ruff"):
+        (line,) = [r for r in requires if re.split(r"[<>=!~; \[]", r.split()[1])[0] == tool]
         assert 'extra == "dev"' in line, line
 
 
