@@ -71,12 +71,12 @@ comparison: $(INSTALLED)
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the
 ## project preset), 32 seeds x 80000 each, then both tables (`playroom ablations`)
-ABLATIONS := $(basename $(notdir $(wildcard experiments/ablations/*.json)))
+ABLATIONS := $(basename $(notdir $(wildcard experiments/batches/ablations/*.json)))
 FROM_STUDY := $(filter-out project%,$(ABLATIONS))
 FROM_PROJECT := $(filter project-plus-%,$(ABLATIONS))
 ablations: replicate
 	for name in $(ABLATIONS); do \
-		$(BIN)/playroom batch --config experiments/ablations/$$name.json \
+		$(BIN)/playroom batch --config experiments/batches/ablations/$$name.json \
 			--out $(OUT)/ablation-$$name || exit 1; \
 	done
 	$(BIN)/playroom ablations $(OUT)/replication $(addprefix $(OUT)/ablation-,$(FROM_STUDY)) \
@@ -107,6 +107,7 @@ test-slow: $(INSTALLED)
 lint: $(INSTALLED)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	$(BIN)/lint-imports
 
 format: $(INSTALLED)
 	$(BIN)/ruff format .

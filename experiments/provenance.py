@@ -23,9 +23,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-PROVENANCE_FILE = "provenance.json"
-# Where a provenance.json that cannot be read is kept when a resume starts a new one.
-DAMAGED_PROVENANCE_FILE = "provenance.damaged.json"
+from experiments.file_names import DAMAGED_PROVENANCE_FILE, PROVENANCE_FILE
 
 # Distributions whose code computes a trial: a change of version may change its bits.
 COMPUTING = (

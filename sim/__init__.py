@@ -1,7 +1,7 @@
 """The playroom world: MuJoCo physics, DMPs, grasp rules, caregiver, vocal tract, dm_control task.
 
 `sim` knows nothing of learning, and importing it leaves the process environment alone: which
-OpenGL backend MuJoCo loads is the caller's choice (`MUJOCO_GL`, see experiments/gl.py).
+OpenGL backend MuJoCo loads is the caller's choice (`MUJOCO_GL`, see experiments/video/gl.py).
 `Playroom` and `Feedback` are loaded on first use, so that `sim.config` and the other plain
 modules can be imported without MuJoCo.
 """

@@ -2,7 +2,7 @@
 
 MuJoCo picks its OpenGL backend when `mujoco` is first imported, and the video tests render
 offscreen in this process: choose EGL here, before any test module imports mujoco (the
-`playroom` command does the same per command, experiments/gl.py).
+`playroom` command does the same per command, experiments/video/gl.py).
 """
 
 import os
@@ -15,8 +15,8 @@ import pytest  # noqa: E402
 @pytest.fixture(scope="session", autouse=True)
 def reference_cache(tmp_path_factory):
     """Reports keep their played references in a folder of the session, not the user's cache
-    (experiments.study_measure.CACHE_ENV, named here so that nothing heavy is imported before
-    the tests choose; subprocesses inherit it)."""
+    (experiments.measure.study_measure.CACHE_ENV, named here so that nothing heavy is imported
+    before the tests choose; subprocesses inherit it)."""
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("PLAYROOM_CACHE_DIR", str(tmp_path_factory.mktemp("reference-cache")))
         yield
@@ -44,7 +44,8 @@ def trained_trial(tmp_path_factory):
     """One short kinematic trial, trained once for the whole session: 3000 iterations, seed 0,
     checkpoints every 1000. Its `.dir` holds the trial. Tests only read it: one that writes
     into a trial copies `.dir` first (shutil.copytree)."""
-    from experiments.trial import TrialSettings, run_trial
+    from experiments.run.settings import TrialSettings
+    from experiments.run.trial import run_trial
 
     settings = TrialSettings(grasp="kinematic", iterations=3000, seed=0, checkpoint_every=1000)
     return run_trial(tmp_path_factory.mktemp("trained") / "trial", settings, progress=False)
@@ -54,8 +55,10 @@ def trained_trial(tmp_path_factory):
 def batches(tmp_path_factory):
     """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0
     (300 iterations, evaluated on 3 placements). Tests only read them."""
-    from experiments.evaluation import EvaluationSettings, evaluate_trial
-    from experiments.trial import TrialSettings, run_trial
+    from experiments.measure.evaluation import EvaluationSettings
+    from experiments.measure.trial_evaluation import evaluate_trial
+    from experiments.run.settings import TrialSettings
+    from experiments.run.trial import run_trial
 
     root = tmp_path_factory.mktemp("batches")
     out = {}

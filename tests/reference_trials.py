@@ -40,7 +40,7 @@ SPREAD_FILE = DATA / "reference-physical-spread.json"
 
 
 def settings(grasp: str, seed: int = SEED):
-    from experiments.trial import TrialSettings
+    from experiments.run.settings import TrialSettings
 
     return TrialSettings(
         grasp=grasp,
@@ -63,7 +63,8 @@ def machine_path(grasp: str) -> Path:
 
 def run_logs(grasp: str, out: Path, seed: int = SEED) -> dict[str, pd.DataFrame]:
     """Run a reference trial into `out`; its two logs by kind."""
-    from experiments.trial import read_log, run_trial
+    from experiments.analysis.logs import read_log
+    from experiments.run.trial import run_trial
 
     run_trial(out, settings(grasp, seed), progress=False)
     return {kind: read_log(out, kind) for kind in ("iterations", "words")}

@@ -15,12 +15,16 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from experiments.ablation import CSV_FILE, FIGURE_FILE, TABLE_FILE, ablation_rows, write_ablations
-from experiments.evaluation import EvaluationSettings, evaluate_trial
-from experiments.results import ReportError
-from experiments.statistics import paired_difference
+from experiments.analysis.results import ReportError
+from experiments.analysis.stats import paired_difference
+from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.for_reports import room_measures
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.report.ablations import ablation_rows, write_ablations
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
 from experiments.storage import config_differences
-from experiments.trial import TrialSettings, run_trial
 
 COMMANDS = 20  # random commands per ring behind the study's measure: enough to compute it
 
@@ -54,7 +58,7 @@ def _competence(batch: Path) -> dict[int, float]:
 
 def test_rows_are_paired_by_seed_and_named_by_the_changed_setting(batches, sigma_batch, tmp_path):
     base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
-    rows = ablation_rows(batches["kinematic"], [sigma_batch], COMMANDS)
+    rows = ablation_rows(batches["kinematic"], [sigma_batch], room_measures(COMMANDS))
     assert [row.label for row in rows] == [
         "baseline (kinematic)",
         "learner.exploration_sigma: 0.1 -> 0.05",
@@ -76,7 +80,7 @@ def test_rows_are_paired_by_seed_and_named_by_the_changed_setting(batches, sigma
 def test_the_baseline_keeps_only_the_seeds_the_ablations_hold(batches, sigma_batch, tmp_path):
     one_seed = tmp_path / "seed1"
     shutil.copytree(sigma_batch / "kinematic-random-seed0001", one_seed / "k-seed0001")
-    baseline, row = ablation_rows(batches["kinematic"], [one_seed], COMMANDS)
+    baseline, row = ablation_rows(batches["kinematic"], [one_seed], room_measures(COMMANDS))
     assert baseline.n_trials == row.n_trials == row.n_pairs == 1
     base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
     assert baseline.competence == pytest.approx(base[1])
@@ -85,28 +89,32 @@ def test_the_baseline_keeps_only_the_seeds_the_ablations_hold(batches, sigma_bat
 
 
 def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
-    table = write_ablations(batches["kinematic"], [sigma_batch], tmp_path / "out", COMMANDS)
-    assert table.name == TABLE_FILE
+    table = write_ablations(
+        batches["kinematic"], [sigma_batch], tmp_path / "out", measures=room_measures(COMMANDS)
+    )
+    assert table.name == ABLATION_TABLE_FILE
     lines = table.read_text().splitlines()
     assert len(lines) == 4 and "learner.exploration_sigma: 0.1 -> 0.05" in lines[3]
-    csv = pd.read_csv(tmp_path / "out" / CSV_FILE)
+    csv = pd.read_csv(tmp_path / "out" / ABLATION_CSV_FILE)
     assert list(csv["n_trials"]) == [2, 2]
     assert {"difference", "difference_p", "study_distance_1_vocal"} <= set(csv.columns)
-    assert (tmp_path / "out" / FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
+    assert (tmp_path / "out" / ABLATION_FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
 
 
 def test_batches_that_cannot_be_paired_are_refused_and_nothing_is_written(batches, tmp_path):
     out = tmp_path / "out"
     with pytest.raises(ReportError, match="none in common"):
-        write_ablations(batches["kinematic"], [batches["physical"]], out, COMMANDS)
+        write_ablations(
+            batches["kinematic"], [batches["physical"]], out, measures=room_measures(COMMANDS)
+        )
     other_seed = tmp_path / "seed7"
     trial = other_seed / "kinematic-random-seed0007"
     run_trial(trial, TrialSettings(iterations=200, seed=7, checkpoint_every=200), progress=False)
     evaluate_trial(trial, EvaluationSettings(n_placements=3))
     with pytest.raises(ReportError, match="shares no seed"):
-        write_ablations(batches["kinematic"], [other_seed], out, COMMANDS)
+        write_ablations(batches["kinematic"], [other_seed], out, measures=room_measures(COMMANDS))
     with pytest.raises(ReportError, match="at least one batch"):
-        write_ablations(batches["kinematic"], [], out, COMMANDS)
+        write_ablations(batches["kinematic"], [], out, measures=room_measures(COMMANDS))
     assert not out.exists()
 
 
@@ -122,7 +130,7 @@ def test_paired_difference_is_the_one_sample_test_of_the_differences():
 
 
 def test_the_command_prints_the_table_and_names_a_bad_batch(batches, sigma_batch, tmp_path, capsys):
-    from experiments.cli import main
+    from experiments.cli.main import main
 
     args = [str(batches["kinematic"]), str(sigma_batch), "--out", str(tmp_path / "out")]
     assert main(["ablations", *args, "--study-reference-commands", str(COMMANDS)]) == 0
@@ -137,8 +145,8 @@ def test_each_ablation_config_changes_one_setting_of_its_preset():
     """The shipped ablations: `NAME.json` switches one study setting back to the project's,
     `project-plus-NAME.json` switches the same setting of the project preset to the study's,
     `project.json` is the project preset's baseline; all on the replication's first seeds."""
-    from experiments.batch import load_spec
-    from experiments.trial import full_config
+    from experiments.batches.spec import load_spec
+    from experiments.run.settings import full_config
 
     folder = Path(__file__).parent.parent / "experiments" / "ablations"
     files = sorted(folder.glob("*.json"))

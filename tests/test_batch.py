@@ -12,18 +12,13 @@ from pathlib import Path
 
 import pytest
 
-from experiments import scheduler as scheduler_module
 from experiments import storage
-from experiments.batch import (
-    TIMING_FILE,
-    BatchError,
-    BatchSpec,
-    is_complete,
-    load_spec,
-    run_batch,
-)
-from experiments.cli import main
-from experiments.trial import CHECKPOINT_FILE, read_log
+from experiments.analysis.logs import read_log
+from experiments.batches import scheduler as scheduler_module
+from experiments.batches.runner import is_complete, run_batch
+from experiments.batches.spec import BatchError, BatchSpec, load_spec
+from experiments.cli.main import main
+from experiments.file_names import CHECKPOINT_FILE, TIMING_FILE
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +77,7 @@ def test_rerun_resumes_an_unfinished_trial_from_its_checkpoint(tmp_path, client)
     name, settings = spec.trials()[0]
     trial_dir = tmp_path / name
     # An interrupted batch: the trial's process is killed after its first checkpoint.
-    args = [sys.executable, "-m", "experiments.cli", "run", "--grasp", "kinematic"]
+    args = [sys.executable, "-m", "experiments.cli.main", "run", "--grasp", "kinematic"]
     args += ["--iterations", "1500", "--seed", "0", "--checkpoint-every", "100", "--quiet"]
     proc = subprocess.Popen([*args, "--out", str(trial_dir)])
     _wait_for_first_checkpoint(trial_dir)
@@ -221,7 +216,7 @@ def test_a_batch_says_when_a_trial_waits_for_another_writer(tmp_path, client):
     spec = _tiny()
     trial = tmp_path / spec.trials()[0][0]
     trial.mkdir()
-    # Another process writes the trial (its lock taken as experiments/lock.py takes it).
+    # Another process writes the trial (its lock taken as experiments/run/lock.py takes it).
     holder = subprocess.Popen(
         [sys.executable, "-c", _HOLD, str(trial / ".lock")],
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,

@@ -13,10 +13,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from experiments import batch as batch_module
-from experiments import scheduler as scheduler_module
-from experiments.batch import BatchError, BatchSpec, load_spec, run_batch
-from experiments.cli import main
+from experiments.batches import runner as batch_module
+from experiments.batches import scheduler as scheduler_module
+from experiments.batches.runner import run_batch
+from experiments.batches.spec import BatchError, BatchSpec, load_spec
+from experiments.cli.main import main
 
 TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_every=10)
 

@@ -8,17 +8,17 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments.cli import main
-from experiments.evaluation import (
+from experiments.cli.main import main
+from experiments.measure.evaluation import (
     GOAL_TIMES,
     EvaluationSettings,
     competence_table,
-    evaluate_trial,
     goal_trajectory,
     normalised_competence,
     strategy_of,
 )
-from experiments.trial import load_trial
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.trial_checks import load_trial
 from models.layout import ARM_DIM
 from sim import Playroom
 

@@ -1,5 +1,5 @@
 """Faults of the machine, not of the request: a full disk and read-only places end a command
-with one line and exit code 1 or 2 (experiments/cli_faults.py), leave nothing half-written,
+with one line and exit code 1 or 2 (experiments/cli/faults.py), leave nothing half-written,
 and leave a trial resumable; reports never write into the batches they read."""
 
 from __future__ import annotations
@@ -13,12 +13,17 @@ from pathlib import Path
 
 import pytest
 
-from experiments import storage, study_measure
-from experiments.cli import main
-from experiments.figures import FigureFile
-from experiments.lock import LOCK_FILE
-from experiments.report import ReportError, write_report
-from experiments.trial import CHECKPOINT_FILE, CONFIG_FILE, TrialSettings, read_log, run_trial
+from experiments import storage
+from experiments.analysis.logs import read_log
+from experiments.analysis.results import ReportError
+from experiments.cli.main import main
+from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, LOCK_FILE
+from experiments.measure import study_measure
+from experiments.measure.for_reports import room_measures
+from experiments.report.batch_report import write_report
+from experiments.report.figures import FigureFile
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -139,14 +144,14 @@ def test_disk_full_during_eval_leaves_the_evaluation_as_it_was(
 def light_figures(monkeypatch):
     """Reports draw two tiny figures instead of their real ones (tests/test_report.py checks
     those): what is checked here is how the files are written."""
-    from experiments import comparison, report
+    from experiments.report import batch_report, comparison
 
     def figures(*args, **kwargs):
         return [
             FigureFile(f"fig{i}.png", "a figure", "its caption", PNG + bytes(i)) for i in (1, 2)
         ]
 
-    for module in (report, comparison):
+    for module in (batch_report, comparison):
         monkeypatch.setattr(module, "report_figures", figures)
         monkeypatch.setattr(module, "study_figure_files", lambda *args: [])
 
@@ -278,22 +283,22 @@ def test_a_cache_that_cannot_be_written_does_not_fail_the_report(
     not_a_folder = tmp_path / "file"
     not_a_folder.write_text("x")
     monkeypatch.setenv(study_measure.CACHE_ENV, str(not_a_folder / "cache"))
-    page = write_report(batches["kinematic"], tmp_path / "out", study_reference_commands=10)
+    page = write_report(batches["kinematic"], tmp_path / "out", measures=room_measures(10))
     assert "as the study computed it" in page.read_text()
 
 
 def test_a_report_into_a_read_only_place_is_refused_before_any_work(
     batches, tmp_path, read_only, monkeypatch
 ):
-    from experiments import report
+    from experiments.report import batch_report
 
     def no_work(*args, **kwargs):
         raise AssertionError("the report should have been refused before its work")
 
-    monkeypatch.setattr(report, "summarise", no_work)
+    monkeypatch.setattr(batch_report, "summarise_batch", no_work)
     read_only(tmp_path)
     with pytest.raises(ReportError, match="cannot write into .*: read-only file system"):
-        write_report(batches["kinematic"], tmp_path / "out")
+        write_report(batches["kinematic"], tmp_path / "out", measures=room_measures(10))
 
 
 # Messages that say what is true ---------------------------------------------------------------
@@ -303,13 +308,13 @@ def test_another_tools_folder_is_not_called_a_batch_of_unevaluated_trials(tmp_pa
     (other / "run-1" / "config.json").write_text('{"lr": 0.1}')  # another tool's config
     (other / "notes.txt").write_text("x")
     with pytest.raises(ReportError) as info:
-        write_report(other, tmp_path / "out")
+        write_report(other, tmp_path / "out", measures=room_measures(10))
     message = str(info.value)
     assert "no trial directories found in" in message and "playroom batch" in message
     assert "eval" not in message
     trial = batches["kinematic"] / "kinematic-random-seed0000"
     with pytest.raises(ReportError, match="is a trial directory, not a batch"):
-        write_report(trial, tmp_path / "out")
+        write_report(trial, tmp_path / "out", measures=room_measures(10))
     assert not (tmp_path / "out").exists()
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
 
 
 @pytest.fixture
@@ -96,7 +96,8 @@ def test_an_unknown_backend_is_one_line_naming_the_choices(tmp_path):
 
 def test_importing_the_packages_leaves_the_environment_alone():
     code = (
-        "import os, sim, learner, experiments.trial, experiments.batch, experiments.report; "
+        "import os, sim, learner, experiments.run.trial, experiments.batches.runner, "
+        "experiments.report.batch_report; "
         "sim.Playroom('kinematic'); print(os.environ.get('MUJOCO_GL'))"
     )
     env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}

@@ -1,4 +1,5 @@
-"""The study's strategies split by the name of the tested toy (experiments/name_strategies.py)."""
+"""The study's strategies split by the name of the tested toy
+(experiments/report/name_strategies.py)."""
 
 from __future__ import annotations
 
@@ -8,14 +9,15 @@ import shutil
 import pandas as pd
 import pytest
 
-from experiments.name_strategies import (
+from experiments.analysis.results import collect
+from experiments.measure.for_reports import room_measures
+from experiments.report.batch_report import write_report
+from experiments.report.name_strategies import (
     NOT_RECORDED,
     name_strategy_table,
     named_tests,
     strategy_shares,
 )
-from experiments.report import write_report
-from experiments.results import collect
 
 
 def _results(batches) -> object:
@@ -95,7 +97,9 @@ def test_trials_evaluated_before_the_toy_was_recorded_give_a_note(batches, tmp_p
 
 
 def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
-    page = write_report(batches["kinematic"], tmp_path / "new", 50).read_text()
+    page = write_report(
+        batches["kinematic"], tmp_path / "new", measures=room_measures(50)
+    ).read_text()
     assert "Strategies by the toy&#39;s name" in page or "Strategies by the toy's name" in page
     assert "names said within the distance" in page or "names never said" in page
     # A trial evaluated before: its vocal table without `toy`.
@@ -103,15 +107,19 @@ def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
     shutil.copytree(batches["kinematic"], batch)
     for path in batch.glob("*/vocal.parquet"):
         pd.read_parquet(path).drop(columns="toy").to_parquet(path)
-    page = write_report(batch, tmp_path / "old-report", 50).read_text()
+    page = write_report(batch, tmp_path / "old-report", measures=room_measures(50)).read_text()
     assert "playroom eval" in page and NOT_RECORDED.split(":")[0] in page
 
 
 def test_the_comparison_splits_both_backends_by_name(batches, tmp_path):
-    from experiments.report import write_comparison
+    from experiments.report.comparison import write_comparison
 
     page = write_comparison(
-        batches["kinematic"], batches["physical"], tmp_path, 20, study_reference_commands=50
+        batches["kinematic"],
+        batches["physical"],
+        tmp_path,
+        grasp_rate_commands=20,
+        measures=room_measures(50),
     ).read_text()
     section = page[page.index("Strategies by the toy") : page.index("<h2>Trials</h2>")]
     for group in ("kinematic", "physical"):

@@ -44,7 +44,7 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
         metadata = archive.read(next(n for n in names if n.endswith("METADATA"))).decode()
     assert "models/playroom.xml" in names
     assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
-    assert "experiments/profiles/demo.json" in names
+    assert "experiments/batches/profiles/demo.json" in names
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
     for tool in ("pytest", "pytest-xdist", "ruff"):
         (line,) = [r for r in requires if re.split(r"[<>=!~; \[]", r.split()[1])[0] == tool]

@@ -20,11 +20,10 @@ import threadpoolctl
 
 import experiments
 from experiments import provenance, storage
-from experiments.cli import main
-from experiments.evaluation import EVAL_FILE
+from experiments.cli.main import main
+from experiments.file_names import CONFIG_FILE, DAMAGED_PROVENANCE_FILE, EVAL_FILE, PROVENANCE_FILE
+from experiments.measure.for_reports import room_measures
 from experiments.provenance import (
-    DAMAGED_PROVENANCE_FILE,
-    PROVENANCE_FILE,
     bit_differences,
     computed_on_line,
     describe,
@@ -33,8 +32,9 @@ from experiments.provenance import (
     short_record,
     source_record,
 )
-from experiments.report import write_report
-from experiments.trial import CONFIG_FILE, TrialSettings, run_trial
+from experiments.report.batch_report import write_report
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
 
 SOURCE_ROOT = Path(experiments.__file__).resolve().parents[1]
 SHORT = TrialSettings(grasp="kinematic", iterations=100, seed=3, checkpoint_every=100)
@@ -258,7 +258,7 @@ def _batch_of_two_machines(batches: dict[str, Path], target: Path) -> Path:
 
 def test_the_report_shows_where_its_trials_ran(batches, tmp_path):
     batch = _batch_of_two_machines(batches, tmp_path / "batch")
-    page = write_report(batch, tmp_path / "out", study_reference_commands=20).read_text()
+    page = write_report(batch, tmp_path / "out", measures=room_measures(20)).read_text()
     section = html.unescape(page.split("<h2>Where the trials ran</h2>")[1].split("<h2>")[0])
     here = short_record(machine_record())
     rows = section.split("<tr>")[2:]  # after the header

@@ -19,7 +19,8 @@ from reference_trials import (
     settings,
 )
 
-from experiments.trial import read_log, run_trial
+from experiments.analysis.logs import read_log
+from experiments.run.trial import run_trial
 
 # How far the physical trial's event counts may lie from the recording's, in standard
 # deviations of the same counts over other seeds: on another CPU the trial may diverge from

@@ -1,4 +1,4 @@
-"""Reports of a batch (`experiments.report`, `.comparison`, `.results`, `.statistics`,
+"""Reports of a batch (`experiments.report.batch_report`, `.comparison`, `.results`, `.statistics`,
 `.paper`): files, embedded figures, statistics checked by hand, the paper's numbers beside
 ours, escaped HTML, and bad input refused with one line and nothing written."""
 
@@ -18,18 +18,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments import figures, paper
-from experiments.curves import curve_rows, tool_numbers
-from experiments.evaluation import EVAL_FILE
-from experiments.report import (
-    COMPARISON_FILE,
-    REPORT_FILE,
-    ReportError,
-    write_comparison,
-    write_report,
-)
-from experiments.results import collect
-from experiments.statistics import (
+from experiments.analysis.curves import curve_rows, tool_numbers
+from experiments.analysis.results import ReportError, collect
+from experiments.analysis.stats import (
     chi_square,
     cost_per_iteration,
     mann_whitney,
@@ -38,6 +29,11 @@ from experiments.statistics import (
     vocal_summary,
     welch,
 )
+from experiments.file_names import COMPARISON_FILE, EVAL_FILE, REPORT_FILE
+from experiments.measure.for_reports import room_measures
+from experiments.report import figures, paper
+from experiments.report.batch_report import write_report
+from experiments.report.comparison import write_comparison
 
 DATA_URI = re.compile(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"')
 
@@ -81,7 +77,7 @@ def test_collect_reads_every_trial_into_tables(batches):
 
 def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     out = tmp_path / "report"
-    page = write_report(batches["kinematic"], out, study_reference_commands=20)
+    page = write_report(batches["kinematic"], out, measures=room_measures(20))
     assert page == out / REPORT_FILE
     _embedded(page, out, "*.png")
     text = page.read_text()
@@ -100,7 +96,7 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
         (trial / "timing.json").write_text(json.dumps({"seconds": 1.5, "iterations": 300}))
     out = tmp_path / "compare"
     page = write_comparison(
-        batches["kinematic"], batch_b, out, grasp_rate_commands=20, study_reference_commands=20
+        batches["kinematic"], batch_b, out, grasp_rate_commands=20, measures=room_measures(20)
     )
     assert page == out / COMPARISON_FILE
     _embedded(page, out, "comparison-*.png")
@@ -208,7 +204,7 @@ def test_cost_per_iteration_and_competence_grid():
 def _refused(batch: Path, tmp_path: Path, *words: str) -> None:
     out = tmp_path / "out"
     with pytest.raises(ReportError) as info:
-        write_report(batch, out)
+        write_report(batch, out, measures=room_measures(10))
     message = str(info.value)
     assert "\n" not in message
     for word in words:
@@ -240,10 +236,12 @@ def test_comparison_of_bad_batches_writes_nothing(batches, tmp_path):
     (tmp_path / "empty").mkdir()
     out = tmp_path / "out"
     with pytest.raises(ReportError):
-        write_comparison(batches["kinematic"], tmp_path / "empty", out)
+        write_comparison(batches["kinematic"], tmp_path / "empty", out, measures=room_measures(10))
     # One batch with both backends compares with itself; with one backend it cannot.
     with pytest.raises(ReportError, match="exactly two groups"):
-        write_comparison(batches["kinematic"], batches["kinematic"], out)
+        write_comparison(
+            batches["kinematic"], batches["kinematic"], out, measures=room_measures(10)
+        )
     assert not out.exists()
 
 
@@ -277,7 +275,7 @@ def _leaves(value) -> list[float]:
 
 
 def test_paper_numbers_load_from_the_data_file_each_with_its_source():
-    numbers = paper.load()  # the packaged experiments/data/paper.json
+    numbers = paper.load()  # the packaged experiments/report/data/paper.json
     assert {"competence_all", "strategy_distance_1", "words_below_threshold"} <= set(numbers)
     assert numbers["competence_all"].value == 0.46
     assert numbers["median_names"].value == 0.23 and numbers["median_distractors"].value == 0.3
@@ -290,7 +288,9 @@ def test_paper_numbers_load_from_the_data_file_each_with_its_source():
 
 
 def test_a_paper_number_without_its_source_is_refused(tmp_path):
-    raw = json.loads(resources.files("experiments").joinpath("data", "paper.json").read_text())
+    raw = json.loads(
+        resources.files("experiments.report").joinpath("data", "paper.json").read_text()
+    )
     del raw["numbers"]["median_names"]["source"]
     path = tmp_path / "paper.json"
     path.write_text(json.dumps(raw))
@@ -310,7 +310,7 @@ def _row(page: str, first_cell: str) -> list[str]:
 def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypatch):
     results = collect(batches["kinematic"])
     page = write_report(
-        batches["kinematic"], tmp_path / "report", study_reference_commands=20
+        batches["kinematic"], tmp_path / "report", measures=room_measures(20)
     ).read_text()
     published = paper.published()
     result, theirs, ours = _row(page, "Normalised competence, all rings")
@@ -322,7 +322,7 @@ def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypat
     edited = dataclasses.replace(published["competence_all"], text="12% <b>edited</b>")
     monkeypatch.setattr(paper, "published", lambda: {**published, "competence_all": edited})
     page = write_report(
-        batches["kinematic"], tmp_path / "edited", study_reference_commands=20
+        batches["kinematic"], tmp_path / "edited", measures=room_measures(20)
     ).read_text()
     assert _row(page, "Normalised competence, all rings")[1] == "12% <b>edited</b>"
 
@@ -333,7 +333,7 @@ def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
         config = json.loads(config_path.read_text())
         config["trial"]["grasp"] = "<script>alert(1)</script>"
         config_path.write_text(json.dumps(config))
-    text = write_report(batch, tmp_path / "out", study_reference_commands=20).read_text()
+    text = write_report(batch, tmp_path / "out", measures=room_measures(20)).read_text()
     assert "<script>" not in text and "<b>batch" not in text
     assert "this batch: &lt;script&gt;alert(1)&lt;/script&gt;" in text
     assert "&lt;b&gt;batch" in text
@@ -363,11 +363,11 @@ def test_stick_numbers_of_a_hand_made_log():
 
 
 def test_the_study_reference_is_played_once_and_kept(batches, tmp_path, monkeypatch):
-    from experiments import study_measure
+    from experiments.measure import study_measure
 
     monkeypatch.setenv(study_measure.CACHE_ENV, str(tmp_path / "cache"))
     batch = _copy_batch(batches, tmp_path / "batch")
-    first = write_report(batch, tmp_path / "one", study_reference_commands=20).read_text()
+    first = write_report(batch, tmp_path / "one", measures=room_measures(20)).read_text()
     # Kept in the cache directory, not in the batch the report only reads.
     assert len(list((tmp_path / "cache").glob("study-reference-*.parquet"))) == 1
     assert not list(batch.glob("study-reference-*"))
@@ -376,7 +376,7 @@ def test_the_study_reference_is_played_once_and_kept(batches, tmp_path, monkeypa
         raise AssertionError("the kept reference should have been read back")
 
     monkeypatch.setattr(study_measure, "random_reference", played)
-    second = write_report(batch, tmp_path / "two", study_reference_commands=20).read_text()
+    second = write_report(batch, tmp_path / "two", measures=room_measures(20)).read_text()
     assert "as the study computed it" in first
     rows = [line for line in first.splitlines() if "as the study computed it" in line]
     assert rows == [line for line in second.splitlines() if "as the study computed it" in line]

@@ -10,18 +10,13 @@ import math
 import pytest
 
 from experiments import storage
-from experiments.cli import main
-from experiments.results import _eval_numbers
-from experiments.trial import (
-    CHECKPOINT_FILE,
-    CONFIG_FILE,
-    TrialError,
-    TrialSettings,
-    full_config,
-    read_log,
-    run_trial,
-)
-from experiments.trial_settings import resume_settings
+from experiments.analysis.logs import read_log
+from experiments.analysis.results import _eval_numbers
+from experiments.cli.main import main
+from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
+from experiments.run.settings import TrialSettings, full_config, resume_settings
+from experiments.run.trial import run_trial
+from experiments.run.trial_files import TrialError
 from learner.config import LearnerConfig
 from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict, world_preset
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig

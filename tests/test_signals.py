@@ -1,5 +1,5 @@
 """Ctrl-C (SIGINT) and SIGTERM end `playroom run` and `playroom batch` with one line saying
-how to resume, exit codes 130 and 143, the trial's lock released (experiments/cli_faults.py)."""
+how to resume, exit codes 130 and 143, the trial's lock released (experiments/faults.py)."""
 
 from __future__ import annotations
 
@@ -15,12 +15,14 @@ from pathlib import Path
 
 import pytest
 
-from experiments import cli_faults, storage
-from experiments.lock import DirectoryLock
-from experiments.trial import CHECKPOINT_FILE, read_log
+from experiments import storage
+from experiments.analysis.logs import read_log
+from experiments.cli import faults
+from experiments.file_names import CHECKPOINT_FILE
+from experiments.run.lock import DirectoryLock
 
 # -X faulthandler: a run that outlives its signal shows where it was (SIGABRT below).
-PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli"]
+PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli.main"]
 REPO = Path(__file__).parent.parent
 
 
@@ -107,7 +109,7 @@ def _ended_by(failure: BaseException, capsys, command: str = "report") -> tuple[
         raise failure
 
     args = argparse.Namespace(command=command, func=func, out="nowhere")
-    code = cli_faults.run_command(args, [command, "x"])
+    code = faults.run_command(args, [command, "x"])
     return code, capsys.readouterr().err
 
 
@@ -121,16 +123,16 @@ def test_each_way_out_has_its_exit_code_and_one_line(capsys):
     )
     code, err = _ended_by(KeyboardInterrupt(), capsys)
     assert (code, err) == (130, "playroom report: interrupted; nothing was written\n")
-    code, err = _ended_by(cli_faults.Terminated(), capsys, command="say")
+    code, err = _ended_by(faults.Terminated(), capsys, command="say")
     assert (code, err) == (143, "playroom say: interrupted\n")
-    code, err = _ended_by(cli_faults.UsageError("bad"), capsys)
+    code, err = _ended_by(faults.UsageError("bad"), capsys)
     assert (code, err) == (2, "playroom report: error: bad\n")
 
 
 def test_sigterm_raises_in_the_block_and_the_handlers_are_restored():
     before = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
-    with pytest.raises(cli_faults.Terminated):
-        with cli_faults.signals_as_exceptions():
+    with pytest.raises(faults.Terminated):
+        with faults.signals_as_exceptions():
             os.kill(os.getpid(), signal.SIGTERM)
             for _ in range(1000):  # the handler runs at the next bytecode boundaries
                 time.sleep(0.001)

@@ -1,4 +1,4 @@
-"""The study's own measure (experiments/study_measure.py), its quirks included."""
+"""The study's own measure (experiments/measure/study_measure.py), its quirks included."""
 
 from __future__ import annotations
 
@@ -6,19 +6,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments.study_measure import (
-    FULL_COVERAGE,
-    GRID,
+from experiments.analysis.study_maps import GRID, competence_map, reference_map, strategy_curve
+from experiments.analysis.study_summary import FULL_COVERAGE, study_summary
+from experiments.measure.study_measure import (
     StudyMeasureSettings,
     _arm_context_of_the_study,
-    competence_map,
     random_reference,
-    reference_map,
-    strategy_curve,
-    study_summary,
     study_tests,
 )
-from experiments.trial import load_trial
+from experiments.run.trial_checks import load_trial
 
 
 def test_the_map_normalises_each_pixel_by_the_random_error_around_its_distance():

@@ -13,14 +13,17 @@ import numpy as np
 import pytest
 
 from experiments import storage
-from experiments.cli import main
-from experiments.trial import CHECKPOINT_FILE, TrialSettings, read_log, run_trial
+from experiments.analysis.logs import read_log
+from experiments.cli.main import main
+from experiments.file_names import CHECKPOINT_FILE
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
 from models.layout import SAMPLE_INDICES
 from sim import Playroom
 from sim.dmp import arm_trajectory
 from sim.kinematics import hand_positions
 
-PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
 REPO = Path(__file__).parent.parent
 
 

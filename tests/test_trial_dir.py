@@ -11,24 +11,26 @@ import numpy as np
 import pytest
 
 from experiments import storage
-from experiments.batch import run_and_evaluate
-from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
-from experiments.lock import LOCK_FILE, DirectoryLock
-from experiments.trial import (
+from experiments.analysis.logs import read_log
+from experiments.batches.runner import run_and_evaluate
+from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
+    EVAL_FILE,
+    LOCK_FILE,
     PREVIOUS_CHECKPOINT_FILE,
-    TrialError,
-    TrialLocked,
-    TrialSettings,
-    read_log,
-    run_trial,
 )
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.lock import DirectoryLock
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_files import TrialError, TrialLocked
 
-PLAYROOM = [sys.executable, "-m", "experiments.cli"]
+PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
 HOLD_LOCK = (
-    "import sys, time; from experiments.lock import DirectoryLock; "
+    "import sys, time; from experiments.run.lock import DirectoryLock; "
     "DirectoryLock(sys.argv[1]).acquire(); print('held', flush=True); time.sleep(600)"
 )
 

@@ -12,22 +12,24 @@ import sys
 import pytest
 
 from experiments import storage
-from experiments.batch import is_complete, run_and_evaluate
-from experiments.cli import main
-from experiments.evaluation import EVAL_FILE, EvaluationSettings, evaluate_trial
-from experiments.lock import LOCK_FILE
-from experiments.trial import (
+from experiments.analysis.logs import read_log
+from experiments.batches.runner import is_complete, run_and_evaluate
+from experiments.cli.main import main
+from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
+    EVAL_FILE,
+    LOCK_FILE,
     LOG_DIR,
     PREVIOUS_CHECKPOINT_FILE,
-    TrialError,
-    TrialSettings,
-    load_trial,
-    read_log,
-    run_trial,
 )
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_checks import load_trial
+from experiments.run.trial_files import TrialError
 
 SEED, TOTAL, PERIOD = 7, 300, 100
 SETTINGS = TrialSettings(iterations=TOTAL, seed=SEED, checkpoint_every=PERIOD)
@@ -127,7 +129,7 @@ def test_killed_between_the_first_log_chunk_and_its_checkpoint_resumes_to_the_sa
 
 # 2. A checkpoint carries its trial's identity ------------------------------------------------
 def test_the_identity_is_the_seed_and_the_settings_that_make_the_trial():
-    from experiments.trial_files import trial_identity
+    from experiments.run.trial_files import trial_identity
 
     config = {
         "trial": {"seed": 3, "iterations": 10, "grasp": "kinematic"},
@@ -159,7 +161,7 @@ def test_a_checkpoint_of_another_trial_is_refused(base, tmp_path, capsys, settin
 
 
 def test_a_checkpoint_without_identity_is_taken_with_a_notice(base, tmp_path):
-    from experiments.trial_files import trial_identity
+    from experiments.run.trial_files import trial_identity
 
     out = _copy(base, tmp_path)
     arrays, meta = storage.read_arrays(out / CHECKPOINT_FILE)

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from scipy.io import wavfile
 
-from experiments import encoding, recording, sound, video
-from experiments.overlay import CameraView
+from experiments.video import encoding, episodes, recording, sound
+from experiments.video.overlay import CameraView
 from models.layout import N_STEPS, VOICE_DIM
 from sim import Playroom
 from sim.scripted import Waypoint, arm_command_through
@@ -74,7 +74,7 @@ def test_short_render_has_frames_sound_and_motion(grasp, reach_command, tmp_path
     room = Playroom(grasp=grasp, seed=0)
     out = tmp_path / "short.mp4"
     per_iteration = LEAD + STEPS + HOLD
-    with video.EpisodeRenderer(SIZE, FPS, lead_frames=LEAD, hold_frames=HOLD) as renderer:
+    with episodes.EpisodeRenderer(SIZE, FPS, lead_frames=LEAD, hold_frames=HOLD) as renderer:
         renderer.render_iteration(room, "arm", reach_command, model="1: arm -> hand")
         voice = np.random.default_rng(0).uniform(-1, 1, VOICE_DIM)
         renderer.render_iteration(room, "voice", voice, audio=[(0.0, *tone())])
@@ -116,7 +116,7 @@ def test_render_random_writes_mp4_with_sound(tmp_path):
         calls.append(m.shape)
         return tone()
 
-    video.render_random(
+    episodes.render_random(
         "kinematic", 3, out, 2, SIZE, voice_audio=voice_audio, lead_frames=0, hold_frames=0
     )
     n_frames, _ = imageio_ffmpeg.count_frames_and_secs(str(out))
@@ -180,40 +180,40 @@ def test_mix_audio_places_resamples_and_clips():
 @pytest.mark.parametrize("size", ["0x120", "160", "abc", "161x120", (160,), (160.0, 120), (-2, 4)])
 def test_bad_size_is_refused(size):
     with pytest.raises(ValueError, match="size"):
-        video.parse_size(size)
+        episodes.parse_size(size)
 
 
 def test_size_text_is_parsed():
-    assert video.parse_size("640x480") == (640, 480)
-    assert video.parse_size((160, 120)) == (160, 120)
+    assert episodes.parse_size("640x480") == (640, 480)
+    assert episodes.parse_size((160, 120)) == (160, 120)
 
 
 def test_bad_output_fails_before_rendering(tmp_path, monkeypatch):
     def no_room(*args, **kwargs):
         raise AssertionError("a room was built before the output path was checked")
 
-    monkeypatch.setattr(video, "Playroom", no_room)
+    monkeypatch.setattr(episodes, "Playroom", no_room)
     with pytest.raises(ValueError, match="does not exist"):
-        video.render_random("kinematic", 0, tmp_path / "missing" / "out.mp4", size=SIZE)
+        episodes.render_random("kinematic", 0, tmp_path / "missing" / "out.mp4", size=SIZE)
     with pytest.raises(ValueError, match="is a directory"):
-        video.render_random("kinematic", 0, tmp_path, size=SIZE)
+        episodes.render_random("kinematic", 0, tmp_path, size=SIZE)
     if os.geteuid() != 0:  # root may write anywhere
         locked = tmp_path / "locked"
         locked.mkdir(mode=0o500)
         with pytest.raises(ValueError, match="not writable"):
-            video.render_random("kinematic", 0, locked / "out.mp4", size=SIZE)
+            episodes.render_random("kinematic", 0, locked / "out.mp4", size=SIZE)
 
 
 def test_failed_mux_is_a_render_error(tmp_path):
     wav = tmp_path / "sound.wav"
     write_wav(wav, np.zeros(100), 8000)
-    with pytest.raises(video.RenderError, match="ffmpeg failed"):
+    with pytest.raises(episodes.RenderError, match="ffmpeg failed"):
         encoding.mux(tmp_path / "no_such_video.mp4", wav, tmp_path / "out.mp4")
 
 
 def test_unknown_camera_is_refused(tmp_path):
     with pytest.raises(ValueError, match="camera"):
-        video.render_random("kinematic", 0, tmp_path / "out.mp4", size=SIZE, camera="side")
+        episodes.render_random("kinematic", 0, tmp_path / "out.mp4", size=SIZE, camera="side")
 
 
 def test_missing_gl_names_mujoco_gl_and_its_choices(monkeypatch):
@@ -222,13 +222,13 @@ def test_missing_gl_names_mujoco_gl_and_its_choices(monkeypatch):
 
     monkeypatch.setattr(recording.mujoco, "Renderer", no_gl)
     room = Playroom(grasp="kinematic", seed=0)
-    with pytest.raises(video.RenderError, match="MUJOCO_GL to one of egl, osmesa, glfw"):
+    with pytest.raises(episodes.RenderError, match="MUJOCO_GL to one of egl, osmesa, glfw"):
         recording.FrameRecorder(room, SIZE)
 
 
 def test_refused_command_adds_no_frames():
     room = Playroom(grasp="kinematic", seed=0)
-    with video.EpisodeRenderer(SIZE, lead_frames=LEAD, hold_frames=HOLD) as renderer:
+    with episodes.EpisodeRenderer(SIZE, lead_frames=LEAD, hold_frames=HOLD) as renderer:
         with pytest.raises(ValueError):
             renderer.render_iteration(room, "arm", np.full(21, 2.0))
         assert renderer.n_frames == 0
@@ -237,7 +237,7 @@ def test_refused_command_adds_no_frames():
 
 def test_rendering_after_write_is_refused(reach_command, tmp_path):
     room = Playroom(grasp="kinematic", seed=0)
-    with video.EpisodeRenderer(SIZE, lead_frames=0, hold_frames=0) as renderer:
+    with episodes.EpisodeRenderer(SIZE, lead_frames=0, hold_frames=0) as renderer:
         renderer.render_iteration(room, "arm", reach_command)
         renderer.write(tmp_path / "once.mp4")
         # A new stream would overwrite the frames already written.
@@ -312,20 +312,20 @@ def test_failed_mux_leaves_the_old_file_whole(tmp_path):
     out = tmp_path / "video.mp4"
     out.write_bytes(b"an older video")
     write_wav(tmp_path / "sound.wav", np.zeros(100), 8000)
-    with pytest.raises(video.RenderError, match="ffmpeg failed"):
+    with pytest.raises(episodes.RenderError, match="ffmpeg failed"):
         encoding.mux_into_place(tmp_path / "missing.mp4", tmp_path / "sound.wav", out)
     assert out.read_bytes() == b"an older video"
     assert sorted(os.listdir(tmp_path)) == ["sound.wav", "video.mp4"]
 
 
 def test_video_modules_leave_mujoco_gl_to_the_caller():
-    """Only the command chooses the GL backend (experiments/gl.py); encoding and sound need
+    """Only the command chooses the GL backend (experiments/video/gl.py); encoding and sound need
     no mujoco at all."""
     code = (
         "import os, sys\n"
-        "import experiments.encoding, experiments.sound\n"
+        "import experiments.video.encoding, experiments.video.sound\n"
         "assert 'mujoco' not in sys.modules, 'encoding or sound imported mujoco'\n"
-        "import experiments.video\n"
+        "import experiments.video.episodes\n"
         "print(os.environ.get('MUJOCO_GL', 'unset'))\n"
     )
     env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
@@ -337,8 +337,10 @@ def test_video_modules_leave_mujoco_gl_to_the_caller():
 # Replaying a trial ----------------------------------------------------------------------------
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_replayed_trial_iterations_reproduce_the_logged_events(tmp_path, grasp, request):
-    from experiments.replay import render_trial
-    from experiments.trial import TrialSettings, read_log, run_trial
+    from experiments.analysis.logs import read_log
+    from experiments.run.settings import TrialSettings
+    from experiments.run.trial import run_trial
+    from experiments.video.replay import render_trial
 
     # Each filmed iteration costs a second of VTL synthesis (the voice or the caregiver's word).
     if grasp == "kinematic":
@@ -360,13 +362,13 @@ def test_replayed_trial_iterations_reproduce_the_logged_events(tmp_path, grasp, 
     )
     assert [r.iteration for r in replayed] == iterations
     assert all(r.matches for r in replayed), [(r.logged, r.replayed) for r in replayed]
-    per_iteration = video.LEAD_FRAMES + N_STEPS + video.HOLD_FRAMES
+    per_iteration = episodes.LEAD_FRAMES + N_STEPS + episodes.HOLD_FRAMES
     assert decoded_frames(path).shape == (len(iterations) * per_iteration, 64, 96, 3)
     assert "Audio:" in stream_listing(path)
 
 
 def test_render_refuses_bad_trial_input_with_one_line(tmp_path, capsys, trained_trial):
-    from experiments.cli import main
+    from experiments.cli.main import main
 
     trial = trained_trial.dir
     before = sorted((p.relative_to(trial), p.stat().st_mtime_ns) for p in trial.rglob("*"))

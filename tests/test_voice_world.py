@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.io import wavfile
 
-from experiments.cli import main
+from experiments.cli.main import main
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev

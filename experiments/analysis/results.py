@@ -1,0 +1,399 @@
+"""A batch directory read into tables (`collect`): one row per trial, test, word or curve point.
+
+A batch directory holds trial directories (any sub-directory with `config.json`), each
+evaluated (`eval.json`, `competence.parquet`, `vocal.parquet`, written by
+`experiments.measure.evaluation`). Trials form groups by grasp backend and babbling mode; within a
+group every setting but the seed must agree, or collecting refuses to pool them.
+
+Every refusal is a `ReportError` whose message is one line naming the trial and what to do, so
+that the CLI can print it as it is.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from experiments import storage
+from experiments.analysis.curves import curve_rows, tool_numbers
+from experiments.analysis.logs import read_log
+from experiments.file_names import (
+    COMPETENCE_FILE,
+    CONFIG_FILE,
+    EVAL_FILE,
+    LOG_DIR,
+    STUDY_TESTS_FILE,
+    TIMING_FILE,
+    VOCAL_FILE,
+)
+from experiments.provenance import SHORT_FIELDS, computed_on
+
+COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
+
+
+class ReportError(Exception):
+    """A batch that cannot be reported on; the message (one line) says why."""
+
+
+@dataclass(frozen=True)
+class BatchResults:
+    """Every table of a batch, one row per trial / test / word / curve point, each row labelled
+    with its trial (`trial`, the directory name), `group` (grasp, plus babbling when a batch
+    mixes modes) and `seed`.
+
+    - trials: eval.json's numbers (competence_all, competence_ring1..3, share_below_threshold,
+      median_names, median_distractors, ...), diverged iterations, and timing.json's
+      seconds / timed_iterations (NaN when not recorded).
+    - competence: competence.parquet rows (ring, placement, toy, x, y, distance, strategy,
+      error, random_error, ...).
+    - vocal: vocal.parquet rows (word, is_name, toy, best_distance); `toy` (the toy a name
+      names, 0 for a distractor) is missing in trials evaluated before it was recorded.
+    - curves: long table (iteration, metric, value) of developmental curves
+      (experiments/analysis/curves.py).
+    - configs: group -> the group's common config (trial.seed removed).
+    - provenance: where each trial was computed (role 'computed', one row per stretch of
+      iterations, from provenance.json) and evaluated (role 'evaluated', from eval.json):
+      from_iteration, status ('recorded', 'not recorded', 'unreadable') and
+      provenance.SHORT_FIELDS (cpu, simd, blas, numpy, mujoco, host, commit).
+    """
+
+    batch_dir: Path
+    trials: pd.DataFrame
+    competence: pd.DataFrame
+    vocal: pd.DataFrame
+    curves: pd.DataFrame
+    configs: dict[str, dict]
+    study_tests: pd.DataFrame = dataclasses.field(
+        default_factory=lambda: pd.DataFrame(columns=["group"])
+    )
+    provenance: pd.DataFrame = dataclasses.field(
+        default_factory=lambda: pd.DataFrame(columns=["group", "seed"])
+    )
+
+    @property
+    def groups(self) -> list[str]:
+        return list(self.configs)
+
+    def select(self, group: str) -> BatchResults:
+        """The results of one group only."""
+        keep = {name: table[table["group"] == group] for name, table in self._tables().items()}
+        return dataclasses.replace(self, **keep, configs={group: self.configs[group]})
+
+    def with_seeds(self, seeds: set[int]) -> BatchResults:
+        """The results of the trials whose seed is in `seeds` only."""
+        keep = {n: t[t["seed"].isin(seeds)] for n, t in self._tables().items() if "seed" in t}
+        return dataclasses.replace(self, **keep)
+
+    def relabel(self, mapping: dict[str, str]) -> BatchResults:
+        """The same results with groups renamed (to tell two batches apart)."""
+        tables = {}
+        for name, table in self._tables().items():
+            table = table.copy()
+            table["group"] = table["group"].map(lambda g: mapping.get(g, g))
+            tables[name] = table
+        configs = {mapping.get(g, g): c for g, c in self.configs.items()}
+        return dataclasses.replace(self, **tables, configs=configs)
+
+    def merge(self, other: BatchResults) -> BatchResults:
+        """Both batches' tables in one (their groups must differ); batch_dir is this one's."""
+        tables = {
+            name: pd.concat([table, other._tables()[name]], ignore_index=True)
+            for name, table in self._tables().items()
+        }
+        return dataclasses.replace(self, **tables, configs={**self.configs, **other.configs})
+
+    def _tables(self) -> dict[str, pd.DataFrame]:
+        return {
+            "trials": self.trials,
+            "competence": self.competence,
+            "vocal": self.vocal,
+            "curves": self.curves,
+            "study_tests": self.study_tests,
+            "provenance": self.provenance,
+        }
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Reach limits and recognition threshold, read from the trials' own settings (not
+    constants), so that a batch run with another arm or stick is reported on its own terms.
+
+    hand_limit, stick_limit: distances from the arm's base (world units, the arm's full reach
+    is 1); threshold: the caregiver's word-recognition distance; bootstrap: iterations of
+    random babbling before learning (arm plus voice)."""
+
+    hand_limit: float
+    stick_limit: float
+    threshold: float
+    bootstrap: int
+
+    @classmethod
+    def of(cls, results: BatchResults) -> Geometry:
+        config = next(iter(results.configs.values()))
+        try:
+            hand = float(sum(config["world"]["segment_lengths"]))
+            stick = hand + float(config["world"]["stick_length"])
+            threshold = float(config["voice"]["recognition_distance"])
+            learner = config["learner"]
+            bootstrap = int(learner["bootstrap_arm"]) + int(learner["bootstrap_voice"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ReportError(
+                f"the trials' config.json lacks a setting the report needs ({exc})"
+            ) from None
+        return cls(hand, stick, threshold, bootstrap)
+
+
+def _read_json(path: Path) -> Any:
+    try:
+        return storage.read_json(path)
+    except storage.CorruptFileError as exc:
+        raise ReportError(str(exc)) from None
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    if not path.exists():
+        raise ReportError(f"{path} is missing: evaluate the trial again (`playroom eval`)")
+    try:
+        return storage.read_table(path)
+    except storage.CorruptFileError as exc:
+        raise ReportError(str(exc).replace("\n", " ")) from None
+
+
+def shared_config(config: dict) -> dict:
+    """A trial's config without its seed: what must agree within a group."""
+    shared = json.loads(json.dumps(config))  # a deep copy, so the seed is popped from a copy
+    shared.get("trial", {}).pop("seed", None)
+    return shared
+
+
+def _names(paths: list[Path], limit: int = 5) -> str:
+    shown = ", ".join(p.name for p in paths[:limit])
+    return shown + (f" and {len(paths) - limit} more" if len(paths) > limit else "")
+
+
+def _is_trial(directory: Path) -> bool:
+    """Whether a folder is a trial directory: `playroom run` writes its config.json and log/
+    (experiments/run/trial_files.py). Another tool's folder with a config.json is not one."""
+    return (directory / CONFIG_FILE).is_file() and (directory / LOG_DIR).is_dir()
+
+
+def _trial_dirs(batch_dir: Path) -> list[Path]:
+    if not batch_dir.is_dir():
+        raise ReportError(f"{batch_dir} is not a directory")
+    if _is_trial(batch_dir):
+        raise ReportError(
+            f"{batch_dir} is a trial directory, not a batch: give the folder that holds trial "
+            f"directories (this one is in {batch_dir.resolve().parent})"
+        )
+    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and _is_trial(d))
+    if not dirs:
+        raise ReportError(
+            f"no trial directories found in {batch_dir}: a batch directory holds one folder per "
+            f"trial (its {CONFIG_FILE} and {LOG_DIR}/), as `playroom batch --out DIR` writes them"
+        )
+    missing = [d for d in dirs if not (d / EVAL_FILE).exists()]
+    if missing:
+        raise ReportError(
+            f"{len(missing)} of {len(dirs)} trials in {batch_dir} have no {EVAL_FILE} "
+            f"(not evaluated): {_names(missing)}; run `playroom eval` on them"
+        )
+    return dirs
+
+
+def check_out_dir(out_dir: Path) -> None:
+    """ReportError, before any work, if out_dir cannot be written (a read-only place, a file)."""
+    try:
+        storage.check_writable(out_dir)
+    except OSError as exc:
+        raise ReportError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
+
+
+def _group_label(grasp: str, babbling: str, mixed_babbling: bool) -> str:
+    return f"{grasp} {babbling}" if mixed_babbling else grasp
+
+
+def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[dict]) -> None:
+    """Every setting but the seed agrees; seeds are distinct; every trial was evaluated at its
+    end on the same number of placements."""
+    reference = shared_config(configs[0])
+    for d, config in zip(dirs[1:], configs[1:], strict=True):
+        differences = storage.config_differences(reference, shared_config(config))
+        if differences:
+            key, a, b = differences[0]  # the first is enough to find the culprit
+            raise ReportError(
+                f"trials of mismatched configs in group {label}: {dirs[0].name} and "
+                f"{d.name} differ in {key} ({a!r} != {b!r})"
+            )
+    seen: dict[int, Path] = {}
+    for d, config in zip(dirs, configs, strict=True):
+        seed = config["trial"]["seed"]
+        if seed in seen:
+            raise ReportError(
+                f"seed {seed} appears twice in group {label} ({seen[seed].name}, {d.name}): "
+                "a trial copied twice would count double"
+            )
+        seen[seed] = d
+    for d, config, summary in zip(dirs, configs, evals, strict=True):
+        if summary.get("evaluated_at_iteration") != config["trial"]["iterations"]:
+            raise ReportError(
+                f"{d.name} was evaluated at iteration {summary.get('evaluated_at_iteration')} "
+                f"of {config['trial']['iterations']}: finish the trial and evaluate it again"
+            )
+    placements = {s.get("n_placements") for s in evals}
+    if len(placements) > 1:
+        raise ReportError(
+            f"trials of group {label} were evaluated on different numbers of placements "
+            f"({sorted(placements, key=str)}): evaluate them again with the same --placements"
+        )
+
+
+def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(iterations log, words log) of a trial; ReportError if unreadable or missing."""
+    try:
+        log, words = read_log(trial_dir), read_log(trial_dir, "words")
+    except storage.CorruptFileError as exc:
+        raise ReportError(str(exc).replace("\n", " ")) from None
+    if log.empty:
+        raise ReportError(f"{trial_dir.name} has no iteration log (log/iterations-*.parquet)")
+    return log, words
+
+
+def _eval_numbers(trial_dir: Path, summary: dict) -> dict[str, float]:
+    """A trial's numbers from its eval.json."""
+    try:
+        vocal = summary["vocal"]
+        return {
+            **{f"competence_{k}": summary["competence"][k] for k in COMPETENCE_SCOPES},
+            "mean_error": summary["mean_error"],
+            "mean_random_error": summary["mean_random_error"],
+            "share_below_threshold": vocal["share_below_threshold"],
+            # null: no voice movement, so no finite distance (experiments/measure/evaluation.py).
+            "median_names": _distance(vocal["median_names"]),
+            "median_distractors": _distance(vocal["median_distractors"]),
+        }
+    except (KeyError, TypeError) as exc:
+        raise ReportError(
+            f"{trial_dir / EVAL_FILE} lacks {exc}: evaluate the trial again (`playroom eval`)"
+        ) from None
+
+
+def _distance(value: float | None) -> float:
+    return math.inf if value is None else value
+
+
+def _timing(trial_dir: Path) -> tuple[float, float]:
+    """(seconds, iterations) of timing.json; NaN, NaN when the trial did not record it."""
+    path = trial_dir / TIMING_FILE
+    if not path.exists():
+        return math.nan, math.nan
+    timing = _read_json(path)
+    try:
+        return float(timing["seconds"]), float(timing["iterations"])
+    except (KeyError, TypeError, ValueError):
+        raise ReportError(f"{path} lacks 'seconds' and 'iterations' numbers") from None
+
+
+def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]:
+    """Where a trial was computed (provenance.json) and evaluated (eval.json's
+    `evaluated_on`): rows of BatchResults.provenance. Trials from before either was recorded
+    have rows of status 'not recorded'; the report counts them as such."""
+    rows = [{**keys, "role": "computed", **stretch} for stretch in computed_on(d)]
+    evaluated = summary.get("evaluated_on")
+    status = "recorded" if isinstance(evaluated, dict) else "not recorded"
+    fields = {k: str(evaluated.get(k, "?")) if evaluated else "" for k in SHORT_FIELDS}
+    rows.append({**keys, "role": "evaluated", "from_iteration": 0, "status": status, **fields})
+    return rows
+
+
+def _trial_rows(
+    d: Path, config: dict, summary: dict, label: str
+) -> tuple[dict[str, Any], pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
+    """(trials row, competence rows, vocal rows, curve rows, the study's test rows or None) of
+    one trial directory."""
+    keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
+    comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
+    voc = _read_table(d / VOCAL_FILE).assign(**keys)
+    log, words = _read_logs(d)
+    reach = sum(config["world"]["segment_lengths"]) + config["world"]["grasp_distance"]
+    names = set(voc.loc[voc["is_name"], "word"])
+    curve = curve_rows(log, words, config["trial"]["iterations"], names, reach).assign(**keys)
+    seconds, timed = _timing(d)
+    row = {
+        **keys,
+        "path": str(d),
+        "grasp": config["trial"]["grasp"],
+        "babbling": config["trial"]["babbling"],
+        "iterations": config["trial"]["iterations"],
+        "n_placements": summary.get("n_placements"),
+        **_eval_numbers(d, summary),
+        "diverged": int(log["diverged"].sum()),
+        **tool_numbers(log, reach),
+        "seconds": seconds,
+        "timed_iterations": timed,
+    }
+    study_path = d / STUDY_TESTS_FILE  # trials evaluated before it existed have none
+    study = _read_table(study_path).assign(**keys) if study_path.exists() else None
+    return row, comp, voc, curve, study
+
+
+def collect(batch_dir: str | os.PathLike) -> BatchResults:
+    """Read every trial of a batch directory into tables. ReportError (one line) for a
+    directory without trials, trials not evaluated, or mismatched configs within a group."""
+    batch_dir = Path(batch_dir)
+    dirs = _trial_dirs(batch_dir)
+    configs = [_read_json(d / CONFIG_FILE) for d in dirs]
+    evals = [_read_json(d / EVAL_FILE) for d in dirs]
+    for d, config in zip(dirs, configs, strict=True):
+        if not isinstance(config, dict) or not {"grasp", "babbling", "seed", "iterations"} <= set(
+            config.get("trial", {})
+        ):
+            raise ReportError(f"{d / CONFIG_FILE} lacks the trial's grasp/babbling/seed")
+    for d, summary in zip(dirs, evals, strict=True):
+        if not isinstance(summary, dict):
+            raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
+    # Babbling joins the label only when it tells groups apart, to keep labels short.
+    mixed = len({c["trial"]["babbling"] for c in configs}) > 1
+    labels = [_group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
+    group_configs: dict[str, dict] = {}
+    for label in sorted(set(labels)):
+        members = [i for i, lab in enumerate(labels) if lab == label]
+        _check_group(
+            label,
+            [dirs[i] for i in members],
+            [configs[i] for i in members],
+            [evals[i] for i in members],
+        )
+        group_configs[label] = shared_config(configs[members[0]])
+
+    rows = [
+        _trial_rows(d, config, summary, label)
+        for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
+    ]
+    trials, competence, vocal, curves, study = zip(*rows, strict=True)
+    where = [
+        row
+        for d, summary, row_keys in zip(dirs, evals, trials, strict=True)
+        for row in _provenance_rows(
+            d, summary, {k: row_keys[k] for k in ("trial", "group", "seed")}
+        )
+    ]
+    studied = [t for t in study if t is not None]
+    return BatchResults(
+        batch_dir=batch_dir,
+        trials=pd.DataFrame(list(trials)),
+        competence=pd.concat(competence, ignore_index=True),
+        vocal=pd.concat(vocal, ignore_index=True),
+        curves=pd.concat(curves, ignore_index=True),
+        configs=group_configs,
+        study_tests=(
+            pd.concat(studied, ignore_index=True) if studied else pd.DataFrame(columns=["group"])
+        ),
+        provenance=pd.DataFrame(where),
+    )

@@ -1,0 +1,198 @@
+"""The report's statistics: pure functions on the tables of `experiments.analysis.results`.
+
+Proportions (competence, strategy shares) are fractions in [0, 1] (competence can be negative:
+worse than random); distances are the caregiver's word distances; costs are seconds. Tests are
+two-sided. Functions return NaN rather than raise where a test has too little data, so that a
+small batch still gets a report with "n/a" where a number cannot be had.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults, Geometry
+
+STRATEGIES = ("hand", "tool", "vocal")
+# Toys at least this far from the arm's base count as "at distance 1" (paper, Fig. 4).
+DISTANCE_ONE = 0.95
+
+
+def mean_ci(values: np.ndarray, confidence: float = 0.95) -> tuple[float, float, float]:
+    """(mean, low, high) of a 1-D array: Student t interval of the mean over its finite
+    values; NaN bounds below 2 finite values, all NaN without any."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    if len(values) == 0:
+        return math.nan, math.nan, math.nan
+    mean = float(values.mean())
+    if len(values) < 2:
+        return mean, math.nan, math.nan
+    half = stats.t.ppf(0.5 + confidence / 2, len(values) - 1) * stats.sem(values)
+    return mean, float(mean - half), float(mean + half)
+
+
+def competence_summary(trials: pd.DataFrame) -> pd.DataFrame:
+    """Per group and scope (all, ring1..3): n trials, mean normalised competence, 95% CI.
+    `trials`: one row per trial with group and competence_<scope> columns."""
+    rows = []
+    for group, table in trials.groupby("group", sort=False):
+        for scope in COMPETENCE_SCOPES:
+            mean, low, high = mean_ci(table[f"competence_{scope}"].to_numpy())
+            rows.append(
+                {
+                    "group": group,
+                    "scope": scope,
+                    "n": len(table),
+                    "mean": mean,
+                    "low": low,
+                    "high": high,
+                }
+            )
+    return pd.DataFrame(rows, columns=["group", "scope", "n", "mean", "low", "high"])
+
+
+def regions(hand_limit: float, stick_limit: float) -> dict[str, tuple[float, float]]:
+    """The paper's three regions of toy distance for strategy shares (Fig. 4's text):
+    name -> [low, high) distance from the arm's base."""
+    return {
+        "centre": (0.0, hand_limit),
+        "between limits": (hand_limit, stick_limit),
+        "distance 1": (DISTANCE_ONE, math.inf),
+    }
+
+
+def strategy_counts(
+    competence: pd.DataFrame, hand_limit: float, stick_limit: float
+) -> pd.DataFrame:
+    """Counts of tests per group and region: columns group, region, hand, tool, vocal."""
+    rows = []
+    for group, table in competence.groupby("group", sort=False):
+        for region, (low, high) in regions(hand_limit, stick_limit).items():
+            inside = table[(table["distance"] >= low) & (table["distance"] < high)]
+            counts = inside["strategy"].value_counts()
+            rows.append(
+                {"group": group, "region": region} | {s: int(counts.get(s, 0)) for s in STRATEGIES}
+            )
+    return pd.DataFrame(rows, columns=["group", "region", *STRATEGIES])
+
+
+def strategy_table(competence: pd.DataFrame, hand_limit: float, stick_limit: float) -> pd.DataFrame:
+    """Shares of hand, tool, vocal per group and region (NaN in a region without tests), with
+    the number of tests n."""
+    counts = strategy_counts(competence, hand_limit, stick_limit)
+    n = counts[list(STRATEGIES)].sum(axis=1)
+    shares = counts[list(STRATEGIES)].div(n.replace(0, np.nan), axis=0)
+    return pd.concat([counts[["group", "region"]], shares, n.rename("n")], axis=1)
+
+
+def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
+    """Share of words below the recognition threshold, median best distance of names and
+    distractors, and a two-sided Mann-Whitney U test of names against distractors.
+    `vocal`: one row per word with is_name and best_distance."""
+    names = vocal.loc[vocal["is_name"], "best_distance"].to_numpy(dtype=float)
+    distractors = vocal.loc[~vocal["is_name"], "best_distance"].to_numpy(dtype=float)
+    u, p = mann_whitney(names, distractors)
+    return {
+        "n_words": len(vocal),
+        "share_below": float((vocal["best_distance"] < threshold).mean()),
+        "median_names": float(np.median(names)) if len(names) else math.nan,
+        "median_distractors": float(np.median(distractors)) if len(distractors) else math.nan,
+        "u": u,
+        "p": p,
+    }
+
+
+def mann_whitney(
+    a: np.ndarray, b: np.ndarray, alternative: str = "two-sided"
+) -> tuple[float, float]:
+    """(U of a, p); NaN when a side is empty. Infinite values (a word never approached) rank
+    above every finite one, which is what they mean. alternative "less": a tends lower."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(a) == 0 or len(b) == 0:
+        return math.nan, math.nan
+    result = stats.mannwhitneyu(a, b, alternative=alternative)
+    return float(result.statistic), float(result.pvalue)
+
+
+def paired_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float, float]:
+    """(mean of a - b, 95% low, high, two-sided p of the paired t test) over pairs a[i], b[i]
+    (e.g. two configurations' results on the same seed); NaN below 2 pairs."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    mean, low, high = mean_ci(a - b)
+    if len(a) < 2 or np.all(a - b == (a - b)[0]):
+        return mean, low, high, math.nan
+    return mean, low, high, float(stats.ttest_rel(a, b).pvalue)
+
+
+def welch(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """(t, two-sided p) of Welch's t test; NaN below 2 values a side or without variance."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(a) < 2 or len(b) < 2 or (np.var(a) == 0 and np.var(b) == 0):
+        return math.nan, math.nan
+    with warnings.catch_warnings():
+        # scipy warns of precision loss on nearly constant samples (e.g. 100% vs 99.99% of
+        # iterations with the stick in reach); the test is still what the table reports.
+        warnings.simplefilter("ignore", RuntimeWarning)
+        result = stats.ttest_ind(a, b, equal_var=False)
+    return float(result.statistic), float(result.pvalue)
+
+
+def chi_square(table: np.ndarray) -> tuple[float, float]:
+    """(chi2, p) of a contingency table (rows x columns of counts), leaving out all-zero rows
+    and columns (they carry no information and make expected counts zero); NaN when fewer
+    than 2x2 remain."""
+    table = np.asarray(table, dtype=float)
+    table = table[table.sum(axis=1) > 0][:, table.sum(axis=0) > 0]
+    if table.shape[0] < 2 or table.shape[1] < 2:
+        return math.nan, math.nan
+    result = stats.chi2_contingency(table)
+    return float(result.statistic), float(result.pvalue)
+
+
+def cost_per_iteration(trials: pd.DataFrame) -> float:
+    """Seconds of compute per iteration over the trials that recorded timing.json; NaN if
+    none did."""
+    timed = trials.dropna(subset=["seconds", "timed_iterations"])
+    if timed.empty or timed["timed_iterations"].sum() <= 0:
+        return math.nan
+    return float(timed["seconds"].sum() / timed["timed_iterations"].sum())
+
+
+def curve_bands(curves: pd.DataFrame) -> pd.DataFrame:
+    """Mean over trials and 95% t interval of each curve metric at each iteration: columns
+    group, metric, iteration, mean, low, high, sorted by the first three."""
+    rows = []
+    for (group, metric, iteration), table in curves.groupby(
+        ["group", "metric", "iteration"], sort=False
+    ):
+        mean, low, high = mean_ci(table["value"].to_numpy())
+        rows.append(
+            {
+                "group": group,
+                "metric": metric,
+                "iteration": iteration,
+                "mean": mean,
+                "low": low,
+                "high": high,
+            }
+        )
+    columns = ["group", "metric", "iteration", "mean", "low", "high"]
+    return pd.DataFrame(rows, columns=columns).sort_values(["group", "metric", "iteration"])
+
+
+def summarise_batch(results: BatchResults, geometry: Geometry) -> dict[str, Any]:
+    """Every number of the report, per group: competence (competence_summary), strategies
+    (strategy_table) and vocal (group -> vocal_summary)."""
+    summary = competence_summary(results.trials)
+    strategies = strategy_table(results.competence, geometry.hand_limit, geometry.stick_limit)
+    vocal = {
+        g: vocal_summary(results.vocal[results.vocal["group"] == g], geometry.threshold)
+        for g in results.groups
+    }
+    return {"competence": summary, "strategies": strategies, "vocal": vocal}

@@ -1,0 +1,1 @@
+"""Batches of trials on Dask: their specs, the scheduler, profiles and ablations."""

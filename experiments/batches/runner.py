@@ -1,0 +1,221 @@
+"""Batches of trials (seeds x grasp backends x babbling modes) on a Dask cluster.
+
+Without a scheduler address the batch runs on a `LocalCluster` of worker processes on this
+machine; with one (`tcp://HOST:PORT`) the same batch runs on an existing cluster, e.g. workers
+started on PBS or SLURM nodes by dask-jobqueue (README). Each trial is one Dask task that runs
+(or resumes) the trial and evaluates it, so:
+- rerunning a batch skips evaluated trials and resumes unfinished ones from their checkpoints;
+- a worker that dies mid-trial has its task rescheduled by Dask on another worker, where it
+  resumes from the trial's last checkpoint: nothing is lost beyond that, nothing duplicated.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import logging
+import os
+import sys
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from concurrent.futures import CancelledError
+from pathlib import Path
+
+from tqdm import tqdm
+
+from experiments import storage
+from experiments.batches import scheduler as dask_scheduler
+from experiments.batches.spec import BatchError, BatchSpec
+from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, EVAL_FILE, TIMING_FILE
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_checks import check_logs
+from experiments.run.trial_files import TrialError, check_identity
+
+# How long a batch task waits for another writer of its trial to finish (s): longer than a
+# trial of the paper profile takes on one core.
+LOCK_WAIT_S = 4 * 3600
+
+
+def is_complete(trial_dir: Path) -> bool:
+    """Whether a trial ran to its end, is whole (its own checkpoint, logs complete up to it)
+    and was evaluated there: what a rerun may skip. Whatever is not (a truncated eval.json,
+    a lost log chunk) is run again, which evaluates it again or reports the damage."""
+    try:
+        config = storage.read_json(trial_dir / CONFIG_FILE)
+        _, meta = storage.read_arrays(trial_dir / CHECKPOINT_FILE)
+        summary = storage.read_json(trial_dir / EVAL_FILE)
+        if not meta.get("finished") or not isinstance(summary, dict):
+            return False
+        if summary.get("evaluated_at_iteration") != meta["iteration"]:
+            return False
+        check_identity(trial_dir / CHECKPOINT_FILE, meta, config)
+        check_logs(trial_dir, int(meta["iteration"]))
+    except (OSError, KeyError, storage.CorruptFileError, TrialError):
+        return False
+    return True
+
+
+def run_and_evaluate(
+    trial_dir: str, settings: TrialSettings, eval_placements: int, topic: str | None = None
+) -> dict:
+    """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
+    for another writer of the trial is told to the client listening on `topic`."""
+    path = Path(trial_dir)
+    # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
+    # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
+    # the batch's last line. A worker draws no bar; a thread lock is enough.
+    tqdm.set_lock(threading.RLock())
+    # Dask may run a task again while its first attempt still runs on a worker it lost touch
+    # with: the second waits for the first to end instead of writing beside it. So does a
+    # task whose trial another batch or `playroom run` writes: the user hears of it.
+    try:
+        lock = DirectoryLock(path).acquire()
+    except DirectoryLocked as exc:
+        dask_scheduler.tell_client(
+            topic,
+            f"waiting (up to {LOCK_WAIT_S / 3600:g} h) for another writer of {path.name} to "
+            f"finish: {exc}",
+        )
+        lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
+    try:
+        resume = (path / "config.json").exists()
+        start = time.perf_counter()
+        trial = run_trial(path, settings, resume=resume, progress=False)
+        if trial.elapsed is not None:
+            # Only the iterations run now are timed, so resumed trials still give a fair cost.
+            storage.write_json(
+                path / TIMING_FILE,
+                {
+                    "seconds": trial.elapsed,
+                    "iterations": settings.iterations - trial.start_iteration,
+                },
+            )
+        summary = evaluate_trial(path, EvaluationSettings(n_placements=eval_placements))
+        summary["wall_seconds"] = time.perf_counter() - start
+    finally:
+        lock.release()
+    return summary
+
+
+def task_key(name: str, trial_dir: Path, settings: TrialSettings, placements: int, run: str) -> str:
+    """The Dask key of a trial's task: its name (as the dashboard shows it), a digest of where
+    and what it runs, and the run's token. Tasks of one key are one task to a scheduler, shared
+    by every client that submits it: so no other batch, configuration or run may ever share a
+    key (a second run of the same batch waits on the trials' locks instead)."""
+    what = json.dumps([str(trial_dir), dataclasses.asdict(settings), placements], sort_keys=True)
+    return f"{name}-{hashlib.sha256(what.encode()).hexdigest()[:8]}-{run}"
+
+
+def run_batch(
+    spec: BatchSpec,
+    out_dir: str | os.PathLike,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    client=None,
+    progress: bool = True,
+    notify: Callable[[str], None] | None = None,
+) -> dict[str, dict]:
+    """Run every trial of `spec` under out_dir (skipping completed ones); returns the
+    evaluation summary of each trial run now, by name. Trials that fail are reported and the
+    others go on; BatchError at the end names the failures, or at once says the scheduler is
+    not one or was lost. `notify` gets the lines said while trials run (default: stderr)."""
+    from distributed import as_completed
+
+    # Workers may run in another directory, or on another machine sharing the file system:
+    # they are sent the path the user meant, not one relative to where they run.
+    out = Path(os.path.abspath(Path(out_dir).expanduser()))
+    if out.exists() and not out.is_dir():
+        raise BatchError(f"{out} is a file, not a directory")
+    todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
+    skipped = len(spec.trials()) - len(todo)
+    if not todo:
+        if progress:
+            print(f"{out}: all {skipped} trials already complete")
+        return {}
+    own_cluster = None
+    if client is None:
+        try:
+            client, own_cluster = dask_scheduler.connect(scheduler, n_workers)
+        except dask_scheduler.SchedulerError as exc:
+            raise BatchError(str(exc)) from None
+    bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
+    if notify is None:
+        notify = lambda line: bar.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
+    run = uuid.uuid4().hex[:8]
+    topic = f"playroom-batch-{run}"
+    results: dict[str, dict] = {}
+    failures: dict[str, str] = {}
+    listening = False
+    try:  # from here on, the cluster this batch started is closed however the batch ends
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise BatchError(f"cannot create {out}: {exc.strerror}") from None
+        dask_scheduler.listen(client, topic, notify)
+        listening = True
+        futures = {}
+        for name, settings in todo:
+            trial_dir = out / name
+            key = task_key(name, trial_dir, settings, spec.eval_placements, run)
+            future = client.submit(
+                run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
+                key=key, pure=False, retries=2,
+            )  # fmt: skip
+            futures[future] = name
+        if skipped and progress:
+            bar.write(f"skipping {skipped} complete trial(s)")
+        for future in as_completed(futures):
+            name = futures[future]
+            try:
+                results[name] = future.result()
+            except Exception as exc:  # a trial's error must not stop the others
+                # Only a lost scheduler cancels a batch's tasks: its keys are its own.
+                if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
+                    raise _lost(scheduler, todo, results) from None
+                failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+            bar.update(1)
+            try:
+                threads = sum(client.nthreads().values())
+            except OSError:  # the scheduler went away
+                raise _lost(scheduler, todo, results) from None
+            # Dask may queue more tasks on a worker than it has threads: at most one task per
+            # thread runs, the rest of the unfinished ones wait.
+            unfinished = sum(not f.done() for f in futures)
+            running = min(unfinished, threads)
+            bar.set_postfix(
+                done=len(results), running=running, waiting=unfinished - running,
+                failed=len(failures),
+            )  # fmt: skip
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (experiments/cli/faults.py)
+        # The workers' complaints about being closed mid-trial would follow the command's one
+        # line; their trials resume from their checkpoints.
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
+    finally:
+        bar.close()
+        if own_cluster is not None:
+            client.close()
+            own_cluster.close()
+        elif listening and not dask_scheduler.scheduler_lost(client):
+            client.unsubscribe_topic(topic)
+    if failures:
+        listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
+        raise BatchError(f"{len(failures)} trial(s) failed: {listed}")
+    return results
+
+
+def _lost(scheduler: str | None, todo: list, results: dict) -> BatchError:
+    """The error of a batch whose scheduler went away."""
+    where = f"at {scheduler}" if scheduler else "of the batch"
+    left = len(todo) - len(results)
+    return BatchError(
+        f"lost the Dask scheduler {where} with {left} trial(s) unfinished; run the same "
+        "command again: complete trials are kept, the others resume from their checkpoints"
+    )

@@ -1,0 +1,177 @@
+"""What a batch holds (`BatchSpec`) and its JSON form (profiles, `--config` files): every
+field checked where the spec is built, without coercion, so that a batch is refused with one
+line naming the setting before anything is written or any cluster started."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from collections import Counter
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from experiments.batches.stored import stored_profiles
+from experiments.run.settings import TrialSettings, full_config
+from experiments.run.trial_files import TrialError
+from learner.config import BABBLING_MODES
+from sim.config import PRESETS, STICK_RETURNS
+
+
+class BatchError(Exception):
+    """A batch that cannot run as asked; the message says why."""
+
+
+GRASPS = ("kinematic", "physical")
+# Fields of a batch config and of `BatchSpec`, with what each may hold (for the messages).
+FIELD_RULES = {
+    "grasps": f"a non-empty list of distinct values from {', '.join(GRASPS)}",
+    "babbling": f"a non-empty list of distinct values from {', '.join(BABBLING_MODES)}",
+    "seeds": "a positive count (seeds 0..N-1) or a non-empty list of distinct integers >= 0",
+    "iterations": "a positive integer",
+    "checkpoint_every": "a positive integer",
+    "eval_placements": "a positive integer (placements per ring)",
+    "stick_return": f"one of {', '.join(STICK_RETURNS)}",
+    "preset": f"one of {', '.join(PRESETS)}",
+    "overrides": 'an object {"world": {...}, "learner": {...}}',
+    "description": "a string",
+}
+
+
+def _is_int(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)  # True is not a count
+
+
+def _field_error(name: str, value: object) -> BatchError:
+    given = json.dumps(value, default=repr)
+    given = given if len(given) <= 60 else given[:57] + "..."  # one line, even for 500 seeds
+    return BatchError(f"{name} must be {FIELD_RULES[name]}, got {given}")
+
+
+@dataclass(frozen=True)
+class BatchSpec:
+    """Which trials a batch holds and how each is run and evaluated. Every field is checked
+    here, without coercion: a batch is refused before anything is written or started."""
+
+    grasps: tuple[str, ...] = GRASPS
+    babbling: tuple[str, ...] = ("random",)
+    seeds: tuple[int, ...] = (0, 1, 2)
+    iterations: int = 1000
+    checkpoint_every: int = 1000
+    eval_placements: int = 100
+    stick_return: str = "out_of_reach"
+    preset: str = "study"
+    overrides: dict = field(default_factory=dict)
+    description: str = field(default="", compare=False)
+
+    def __post_init__(self) -> None:
+        for name, allowed in (("grasps", GRASPS), ("babbling", BABBLING_MODES)):
+            values = getattr(self, name)
+            if (
+                not isinstance(values, tuple)
+                or not values
+                or any(v not in allowed for v in values)
+                or len(set(values)) != len(values)
+            ):
+                raise _field_error(name, values)
+        if not isinstance(self.seeds, tuple) or not self.seeds:
+            raise _field_error("seeds", self.seeds)
+        if not all(_is_int(s) and s >= 0 for s in self.seeds):
+            raise _field_error("seeds", self.seeds)
+        twice = sorted(s for s, n in Counter(self.seeds).items() if n > 1)
+        if twice:
+            raise BatchError(f"seeds must be distinct: {twice} given more than once")
+        for name in ("iterations", "checkpoint_every", "eval_placements"):
+            value = getattr(self, name)
+            if not _is_int(value) or value <= 0:
+                raise _field_error(name, value)
+        if self.stick_return not in STICK_RETURNS:
+            raise _field_error("stick_return", self.stick_return)
+        if self.preset not in PRESETS:
+            raise _field_error("preset", self.preset)
+        if not isinstance(self.overrides, dict) or not all(
+            k in ("world", "learner") and isinstance(v, dict) for k, v in self.overrides.items()
+        ):
+            raise _field_error("overrides", self.overrides)
+        if not isinstance(self.description, str):
+            raise _field_error("description", self.description)
+
+    def trials(self) -> list[tuple[str, TrialSettings]]:
+        """(directory name, settings) of every trial, in a stable order."""
+        out = []
+        for grasp in self.grasps:
+            for babbling in self.babbling:
+                for seed in self.seeds:
+                    name = f"{grasp}-{babbling}-seed{seed:04d}"
+                    settings = TrialSettings(
+                        grasp=grasp,
+                        iterations=self.iterations,
+                        seed=seed,
+                        babbling=babbling,
+                        checkpoint_every=min(self.checkpoint_every, self.iterations),
+                        stick_return=self.stick_return,
+                        preset=self.preset,
+                        overrides=self.overrides,
+                    )
+                    out.append((name, settings))
+        return out
+
+    def check_configs(self) -> None:
+        """TrialError unless every trial's world and learner can be built (the overrides fit
+        them): one trial per grasp and babbling, since seeds change nothing of that."""
+        first = self.trials()[0][1]
+        for grasp in self.grasps:
+            for babbling in self.babbling:
+                full_config(dataclasses.replace(first, grasp=grasp, babbling=babbling))
+
+
+def load_spec(
+    profile: str | None = None, config_file: str | os.PathLike | None = None
+) -> BatchSpec:
+    """A stored profile (experiments/batches/profiles/NAME.json) or a JSON file of the same form,
+    checked whole: BatchError names the first setting that is not what it may be."""
+    if (profile is None) == (config_file is None):
+        raise BatchError("give exactly one of --profile NAME or --config FILE")
+    if profile is not None:
+        if profile not in stored_profiles():
+            choices = ", ".join(stored_profiles())
+            raise BatchError(f"unknown profile {profile!r}: choose one of {choices}")
+        profiles = resources.files("experiments.batches").joinpath("profiles")
+        text = profiles.joinpath(f"{profile}.json").read_text()
+        source = f"profile {profile}"
+    else:
+        path = Path(config_file)
+        if not path.is_file():
+            raise BatchError(f"batch config {path} does not exist")
+        try:
+            text, source = path.read_text(), str(path)
+        except (OSError, UnicodeDecodeError) as exc:
+            raise BatchError(f"cannot read batch config {path}: {exc}") from None
+    try:
+        raw = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise BatchError(f"{source} is not valid JSON ({exc})") from None
+    if not isinstance(raw, dict):
+        raise BatchError(f"{source} must hold a JSON object of the fields {', '.join(FIELD_RULES)}")
+    unknown = sorted(set(raw) - set(FIELD_RULES))
+    if unknown:
+        raise BatchError(
+            f"{source}: unknown field(s) {', '.join(unknown)}; known: {', '.join(FIELD_RULES)}"
+        )
+    given = dict(raw)
+    # JSON has lists where the spec has tuples; nothing else is converted.
+    for name in ("grasps", "babbling", "seeds"):
+        if isinstance(given.get(name), list):
+            given[name] = tuple(given[name])
+    seeds = given.get("seeds")
+    if _is_int(seeds):
+        if seeds <= 0:
+            raise BatchError(f"{source}: {_field_error('seeds', seeds)}")
+        given["seeds"] = tuple(range(seeds))
+    try:
+        spec = BatchSpec(**given)
+        spec.check_configs()
+    except (BatchError, TrialError) as exc:
+        raise BatchError(f"{source}: {exc}") from None
+    return spec

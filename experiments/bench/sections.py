@@ -1,0 +1,213 @@
+"""`playroom bench`: speed figures measured side by side in one run.
+
+Each figure is printed as `name: value unit`, one per line, so runs can be compared with diff.
+Ratios are what to compare across machines; absolute times are printed beside them.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+
+import mujoco
+import numpy as np
+
+from models.layout import ARM_DIM, N_STEPS, SAMPLE_INDICES
+from sim import Playroom
+from sim.physics import CONTROL_SUBSTEPS
+from sim.tracking import hand_tracking_errors
+
+# Targets of the trial and learner figures (ratios to 500 bare mj_step; ms).
+TRIAL_TARGETS = {"kinematic": 0.25, "physical": 1.6}
+LEARNER_TARGET_MS = 0.25
+LEARNER_SIZES = (10000, 40000, 80000)
+
+
+def _seconds_per_call(fn: Callable[[], object], repeats: int) -> float:
+    """Best of 3 rounds of `repeats` calls: the least disturbed by other work on the machine."""
+    best = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        for _ in range(repeats):
+            fn()
+        best = min(best, (time.perf_counter() - start) / repeats)
+    return best
+
+
+def world_figures(iterations: int = 100, seed: int = 0) -> Iterator[tuple[str, float, str]]:
+    """Cost of an arm iteration in each backend against bare mj_step calls on the same model."""
+    rng = np.random.default_rng(seed)
+    commands = rng.uniform(-1.0, 1.0, (iterations, ARM_DIM))
+    cost = {}
+    for grasp in ("physical", "kinematic"):
+        room = Playroom(grasp=grasp, seed=seed)
+        queue = iter(np.tile(commands, (3, 1)))
+        cost[grasp] = _seconds_per_call(lambda r=room, q=queue: r.act_arm(next(q)), iterations)
+    room = Playroom(grasp="physical", seed=seed)
+    m, d = room.physics.model.ptr, room.physics.data.ptr
+    n_steps = N_STEPS * CONTROL_SUBSTEPS
+    bare = _seconds_per_call(lambda: mujoco.mj_step(m, d, n_steps), iterations)
+    yield "physical_arm_iteration", cost["physical"] * 1e3, "ms"
+    yield f"bare_mj_step_x{n_steps}", bare * 1e3, "ms"
+    yield "physical_arm_iteration_over_bare_mj_step", cost["physical"] / bare, "ratio"
+    yield "kinematic_arm_iteration", cost["kinematic"] * 1e3, "ms"
+    yield "kinematic_over_physical", cost["kinematic"] / cost["physical"], "ratio"
+
+
+def tracking_figures(n_commands: int = 1000) -> Iterator[tuple[str, float, str]]:
+    errors = hand_tracking_errors(n_commands)
+    yield "hand_tracking_error_mean", errors.mean() * 1e3, f"mm over {n_commands} commands"
+    yield "hand_tracking_error_max", errors.max() * 1e3, "mm"
+
+
+def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
+    """The fitted formant map against the exact path, and the vocal part of an iteration."""
+    from models.layout import VOICE_DIM
+    from sim.dmp import voice_trajectory
+    from sim.vocal.tract import VocalTract
+    from sim.vocal.words import normalise
+
+    rng = np.random.default_rng(0)
+    frames = rng.uniform(-1.0, 1.0, (repeats, 7))
+    fast, exact = VocalTract(exact=False), VocalTract(exact=True)
+    frame = iter(np.tile(frames, (3, 1)))
+    exact_s = _seconds_per_call(lambda: exact.formants(next(frame)), repeats)
+    # The learning loop sends a movement's 50 frames through the map at once.
+    movements = iter(rng.uniform(-1.0, 1.0, (3 * repeats, 50, 7)))
+    fast_s = _seconds_per_call(lambda: fast.formants(next(movements)), repeats) / 50
+    yield "formants_exact_per_frame", exact_s * 1e3, "ms"
+    yield "formants_fast_map_per_frame", fast_s * 1e6, "us (in a movement of 50 frames)"
+    yield "fast_map_speedup", exact_s / fast_s, "x (target >= 1000)"
+    commands = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
+    samples = list(SAMPLE_INDICES)
+
+    def vocal_part() -> None:
+        # What act_voice does with the voice: the DMP, the formants of the 50 frames (the
+        # sound sensor's readings), and the caregiver hearing the 5 samples.
+        formants = fast.formants(voice_trajectory(next(commands)).T)
+        fast.recognise(normalise(formants[samples]))
+
+    yield (
+        "act_voice_vocal_part",
+        _seconds_per_call(vocal_part, repeats) * 1e3,
+        ("ms (target <= 0.5)"),
+    )
+    room = Playroom("kinematic", seed=0)
+    voice = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
+    yield (
+        "act_voice_kinematic_iteration",
+        _seconds_per_call(lambda: room.act_voice(next(voice)), repeats) * 1e3,
+        "ms",
+    )
+
+
+def learner_figures(sizes: tuple[int, ...] = LEARNER_SIZES) -> Iterator[tuple[str, float, str]]:
+    """The memory's query against brute force, and the learner's own cost per iteration with
+    every model holding 10000, 40000 and 80000 experiences."""
+    from learner import bench as learner_bench
+
+    largest = max(sizes)
+    query = learner_bench.query_ratio(n_rows=largest)
+    worst = max(query["by_dim"].values(), key=lambda d: d["memory_s"] / d["brute_s"])
+    yield f"inverse_query_over_brute_force_at_{largest}_rows", query["ratio"], "ratio"
+    yield "inverse_query", worst["memory_s"] * 1e6, "us"
+    yield "brute_force_scan", worst["brute_s"] * 1e6, "us"
+    for n_rows, seconds in learner_costs(sizes).items():
+        target = f" (target <= {LEARNER_TARGET_MS})" if n_rows == largest else ""
+        yield f"learner_per_iteration_at_{n_rows}_rows", seconds * 1e3, f"ms{target}"
+    yield "peak_memory_with_all_models_full", _peak_rss_mb(), "MB (target < 1024)"
+
+
+def learner_costs(sizes: tuple[int, ...]) -> dict[int, float]:
+    """Seconds per iteration of propose + learn with every model holding n rows, per n; the
+    experiences come from the study's kinematic world, whose own time is not counted."""
+    from learner import bench as learner_bench
+
+    return {
+        n: learner_bench.learner_overhead(Playroom("kinematic", seed=1), n_rows=n)["mean_s"]
+        for n in sizes
+    }
+
+
+def trial_seconds_per_iteration(grasp: str, iterations: int) -> float:
+    """A whole trial from a fresh start (voice, learning, logging, checkpoints included)."""
+    import tempfile
+
+    from experiments.run.settings import TrialSettings
+    from experiments.run.trial import run_trial
+
+    with tempfile.TemporaryDirectory() as out:
+        settings = TrialSettings(grasp=grasp, iterations=iterations, checkpoint_every=1000)
+        start = time.perf_counter()
+        run_trial(out, settings, progress=False)
+        return (time.perf_counter() - start) / iterations
+
+
+def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
+    """Whole trials of both backends side by side, against 500 bare mj_step on the same
+    model, and the projected time of the `paper` profile."""
+    from experiments.batches.spec import load_spec
+    from learner.quantized_scan import warm_up
+
+    # The memory's compiled kernel loads once per process (a batch worker runs many trials):
+    # timed on its own, so the trials below measure iterations alone.
+    start = time.perf_counter()
+    warm_up()
+    yield "memory_kernel_load_once_per_process", time.perf_counter() - start, "s"
+    per_iteration = {
+        g: trial_seconds_per_iteration(g, iterations) for g in ("kinematic", "physical")
+    }
+    room = Playroom(grasp="physical", seed=0)
+    m, d = room.physics.model.ptr, room.physics.data.ptr
+    n_steps = N_STEPS * CONTROL_SUBSTEPS
+    bare = _seconds_per_call(lambda: mujoco.mj_step(m, d, n_steps), 100)
+    yield f"bare_mj_step_x{n_steps}", bare * 1e3, "ms"
+    for grasp, seconds in per_iteration.items():
+        yield f"{grasp}_trial_{iterations}", 1.0 / seconds, "iterations/s"
+        target = TRIAL_TARGETS[grasp]
+        yield (
+            f"{grasp}_trial_iteration_over_bare_mj_step",
+            seconds / bare,
+            f"ratio (target <= {target})",
+        )
+    # A trial's learner grows with its memory: at 80000 iterations its mean memory is at most
+    # 40000 rows a model, against under 10000 in the short trial measured here.
+    costs = learner_costs((10000, 40000))
+    growth = max(0.0, costs[40000] - costs[10000])
+    spec = load_spec("paper")
+    trial_s = {g: spec.iterations * (per_iteration[g] + growth) for g in spec.grasps}
+    yield "kinematic_trial_80000_projected", trial_s["kinematic"], "s (target < 60, one core)"
+    yield "physical_trial_80000_projected", trial_s["physical"] / 3600, "h (one core)"
+    total = sum(trial_s[g] for g in spec.grasps) * len(spec.seeds) * len(spec.babbling)
+    for cores in (1, 16, 100):
+        yield f"paper_profile_on_{cores}_cores", total / cores / 3600, "h (running, projected)"
+
+
+def render_figures() -> Iterator[tuple[str, float, str]]:
+    """Offscreen rendering speed (needs an OpenGL backend: the CLI chooses it first)."""
+    from experiments.video import episodes
+
+    yield from episodes.render_figures()
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
+    "trial": trial_figures,
+    "learner": learner_figures,
+    "world": world_figures,
+    "tracking": tracking_figures,
+    "voice": voice_figures,
+    "render": render_figures,
+}
+
+
+def run_bench(sections: list[str] | None = None) -> None:
+    """Print every figure of the chosen sections (all by default)."""
+    for name in sections or list(SECTIONS):
+        for figure, value, unit in SECTIONS[name]():
+            print(f"{figure}: {value:.4g} {unit}", flush=True)

@@ -1,0 +1,1 @@
+"""The `playroom` command line."""

@@ -1,0 +1,52 @@
+"""Every file a trial directory or a batch directory holds, by name, in one place.
+
+A trial directory (experiments/run/trial.py writes it) holds the trial itself: its settings,
+checkpoints, logs, provenance and lock (TRIAL_ENTRIES); everything else in it was derived from
+the trial at some iteration (its evaluation, its timing) and is moved aside into
+`stale-at-NNNNNNNN/` when the trial is extended. A batch directory holds one trial directory
+per trial, and the pages written about it.
+"""
+
+from __future__ import annotations
+
+# The trial itself -----------------------------------------------------------------------
+CONFIG_FILE = "config.json"
+CHECKPOINT_FILE = "checkpoint.npz"
+PREVIOUS_CHECKPOINT_FILE = "checkpoint.prev.npz"
+# Where a damaged newest checkpoint is kept when a resume falls back past it.
+DAMAGED_CHECKPOINT_FILE = "checkpoint.damaged.npz"
+LOG_DIR = "log"
+# Where the machine, libraries and commit of each stretch of iterations are recorded
+# (experiments/provenance.py), and where one that cannot be read is kept aside.
+PROVENANCE_FILE = "provenance.json"
+DAMAGED_PROVENANCE_FILE = "provenance.damaged.json"
+# The lock of the directory's one writer (experiments/run/lock.py).
+LOCK_FILE = ".lock"
+TRIAL_ENTRIES = (
+    CONFIG_FILE,
+    CHECKPOINT_FILE,
+    PREVIOUS_CHECKPOINT_FILE,
+    DAMAGED_CHECKPOINT_FILE,
+    LOG_DIR,
+    LOCK_FILE,
+    PROVENANCE_FILE,
+    DAMAGED_PROVENANCE_FILE,
+)
+# Derived files of a shorter run, moved aside when a trial is extended.
+STALE_PREFIX = "stale-at-"
+
+# Derived from the trial ---------------------------------------------------------------------
+EVAL_FILE = "eval.json"
+COMPETENCE_FILE = "competence.parquet"
+VOCAL_FILE = "vocal.parquet"
+# The tests of the study's own measure (experiments/measure/study_measure.py).
+STUDY_TESTS_FILE = "study-tests.parquet"
+# Seconds and iterations of the batch task that last ran the trial.
+TIMING_FILE = "timing.json"
+
+# Pages about a batch ------------------------------------------------------------------------
+REPORT_FILE = "report.html"
+COMPARISON_FILE = "comparison.html"
+ABLATION_TABLE_FILE = "ablations.md"
+ABLATION_CSV_FILE = "ablations.csv"
+ABLATION_FIGURE_FILE = "ablations.png"

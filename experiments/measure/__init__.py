@@ -1,0 +1,1 @@
+"""Measuring trials: the project's evaluation and the study's tests, in rooms."""

@@ -1,0 +1,188 @@
+"""Evaluation of a trial after learning (docs/protocol.md §10).
+
+Competence: for each ring and each of `n_placements` seeded placements of the 3 toys in that
+ring, and for each toy, the goal is the toy moved straight to the arm's base, sampled at
+t = 0, 0.3, 0.5, 0.8, 1 (goal_k = toy * (1 - t_k)), a 10D trajectory. The agent compares the
+nearest-neighbour distances of (context, goal) in its arm model and its voice model of that
+toy, executes the closer model's inverse without exploration noise, and the error is the
+distance between the toy's 10D trajectory and the goal. A random agent (a random motor space,
+a random command) acts on the very same placements: normalised competence is
+1 - error / random error, so 0 is as bad as acting at random and 1 is perfect.
+
+Every test starts from the same scene: the stick at its start place, the toys at the placement,
+a seeded caregiver position. The trial's own files are read, never written, except the
+evaluation's outputs (`eval.json`, `competence.parquet`, `vocal.parquet`); eval.json names the
+machine it was computed on (`evaluated_on`, experiments/provenance.py). eval.json is standard
+JSON: a number that is not finite (a best distance before any voice movement) is null.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from learner.agent import Agent
+from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
+from sim import Playroom
+from sim import events as ev
+from sim.vocal.config import DEFAULT_VOICE
+
+# Times at which the goal trajectory samples the toy's way to the centre (docs/protocol.md §10).
+GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
+# Evaluation placements come from their own seed, the same for every trial and backend, so
+# that trials are compared on identical tests.
+EVAL_SEED = 20170000
+
+
+@dataclass(frozen=True)
+class EvaluationSettings:
+    n_placements: int = 100
+    seed: int = EVAL_SEED
+
+
+def goal_trajectory(toy: np.ndarray) -> np.ndarray:
+    """(10,) 5 x then 5 y of a toy at `toy` (2,) moved straight to (0, 0)."""
+    points = np.outer(1.0 - GOAL_TIMES, toy)  # (5, 2)
+    return np.concatenate([points[:, 0], points[:, 1]])
+
+
+def placements(
+    ring: tuple[float, float], n: int, rng: np.random.Generator, min_gap: float
+) -> np.ndarray:
+    """(n, 3, 2) toy positions, each toy uniform in the ring (area-uniform radius is not the
+    study's rule: like the world's placements, the radius is uniform), toys at least
+    `min_gap` (m) apart: two solid toys cannot overlap."""
+    out = np.empty((n, 3, 2))
+    for p in range(n):
+        for i in range(3):
+            while True:
+                radius = rng.uniform(*ring)
+                angle = rng.uniform(0.0, 2 * np.pi)
+                xy = radius * np.array([np.cos(angle), np.sin(angle)])
+                if all(np.linalg.norm(xy - out[p, j]) >= min_gap for j in range(i)):
+                    break
+            out[p, i] = xy
+    return out
+
+
+def strategy_of(motor_space: str, stick_moved: bool) -> str:
+    """hand (arm, stick still), tool (arm, stick moved) or vocal (voice): docs/protocol.md §10."""
+    if motor_space == "voice":
+        return "vocal"
+    return "tool" if stick_moved else "hand"
+
+
+def competence_table(
+    agent: Agent, room: Playroom, settings: EvaluationSettings, progress: bool = False
+) -> pd.DataFrame:
+    """One row per (ring, placement, toy): positions, the agent's strategy and error, the
+    random agent's error. The room is used as a test bench; the agent is only read."""
+    rng = np.random.default_rng(settings.seed)
+    stick_start = (*room.config.stick_start_handle, room.config.stick_start_angle)
+    rows = []
+    total = len(room.config.toy_rings) * settings.n_placements * 3
+    # `with`: the bar's line is ended however the evaluation ends (Ctrl-C, a fault).
+    with tqdm(total=total, disable=not progress, desc="evaluation", unit="test") as bar:
+        for ring_index, ring in enumerate(room.config.toy_rings, start=1):
+            toys_of = placements(ring, settings.n_placements, rng, room.min_toy_gap)
+            caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
+            for p in range(settings.n_placements):
+                room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])
+                scene = room.get_state()
+                context = room.context()
+                for toy in range(3):
+                    goal = goal_trajectory(toys_of[p, toy])
+                    block = block_slice(f"toy{toy + 1}")
+                    arm_model, voice_model = agent.toy_models(toy + 1)
+                    d_arm = agent.nearest_distance(arm_model, context, goal)
+                    d_voice = agent.nearest_distance(voice_model, context, goal)
+                    space, model = (
+                        ("arm", arm_model) if d_arm <= d_voice else ("voice", voice_model)
+                    )
+                    untrained = not np.isfinite(min(d_arm, d_voice))
+                    # A toy never moved has no model to invert: the arm stays at rest.
+                    command = (
+                        np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
+                    )
+                    feedback = room.act(space, command)
+                    stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
+                    stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
+                    error = float(np.linalg.norm(feedback.s[block] - goal))
+                    room.set_state(scene)
+                    random_space = "arm" if rng.random() < 0.5 else "voice"
+                    dim = MOTOR_DIMS[random_space]
+                    random_fb = room.act(random_space, rng.uniform(-1, 1, dim))
+                    random_error = float(np.linalg.norm(random_fb.s[block] - goal))
+                    room.set_state(scene)
+                    rows.append(
+                        {
+                            "ring": ring_index,
+                            "placement": p,
+                            "toy": toy + 1,
+                            "x": toys_of[p, toy, 0],
+                            "y": toys_of[p, toy, 1],
+                            "distance": float(np.linalg.norm(toys_of[p, toy])),
+                            "arm_nn_distance": d_arm,
+                            "voice_nn_distance": d_voice,
+                            "strategy": strategy_of(space, bool(stick_moved)),
+                            # A tool test either held the stick or only pushed it.
+                            "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
+                            "untrained": untrained,
+                            "error": error,
+                            "random_error": random_error,
+                        }
+                    )
+                    bar.update(1)
+    return pd.DataFrame(rows)
+
+
+def vocal_table(best_word_distance: np.ndarray, names: tuple[str, ...]) -> pd.DataFrame:
+    """One row per word: its best distance to any sound the agent produced, name or not, and
+    the toy it names (names[i] names toy i + 1; 0 for a distractor)."""
+    words = DEFAULT_VOICE.words
+    return pd.DataFrame(
+        {
+            "word": list(words),
+            "is_name": [w in names for w in words],
+            "toy": [names.index(w) + 1 if w in names else 0 for w in words],
+            "best_distance": np.asarray(best_word_distance, dtype=float),
+        }
+    )
+
+
+def normalised_competence(table: pd.DataFrame) -> float:
+    """1 - mean error / mean random error: 0 = random agent, 1 = perfect."""
+    return float(1.0 - table["error"].mean() / table["random_error"].mean())
+
+
+def summarise_trial(config: dict, competence: pd.DataFrame, vocal: pd.DataFrame) -> dict:
+    """The numbers of eval.json."""
+    threshold = DEFAULT_VOICE.recognition_distance
+    by_ring = {f"ring{r}": normalised_competence(group) for r, group in competence.groupby("ring")}
+    strategies = (
+        competence.groupby("ring")["strategy"].value_counts(normalize=True).unstack(fill_value=0)
+    )
+    names = vocal[vocal["is_name"]]["best_distance"]
+    distractors = vocal[~vocal["is_name"]]["best_distance"]
+    return {
+        "grasp": config["trial"]["grasp"],
+        "seed": config["trial"]["seed"],
+        "babbling": config["trial"]["babbling"],
+        "iterations": config["trial"]["iterations"],
+        "competence": {"all": normalised_competence(competence), **by_ring},
+        "mean_error": float(competence["error"].mean()),
+        "mean_random_error": float(competence["random_error"].mean()),
+        "strategy_share": {
+            f"ring{r}": {k: float(v) for k, v in row.items()} for r, row in strategies.iterrows()
+        },
+        "vocal": {
+            "best_distance": dict(zip(vocal["word"], vocal["best_distance"], strict=True)),
+            "names": [w for w, n in zip(vocal["word"], vocal["is_name"], strict=True) if n],
+            "share_below_threshold": float((vocal["best_distance"] < threshold).mean()),
+            "median_names": float(names.median()),
+            "median_distractors": float(distractors.median()),
+        },
+    }

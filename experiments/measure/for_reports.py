@@ -1,0 +1,19 @@
+"""The room measures a report needs (experiments/analysis/room_measures.py), measured here."""
+
+from __future__ import annotations
+
+import functools
+
+from experiments.analysis.room_measures import RoomMeasures
+from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
+from experiments.measure.stick import grasp_rates
+from experiments.measure.study_measure import study_numbers
+
+
+def room_measures(study_reference_commands: int = RANDOM_COMMANDS_PER_RING) -> RoomMeasures:
+    """The study's numbers against a reference of `study_reference_commands` random commands
+    per ring (the study's 30000 by default), and the stick's grasp rates."""
+    return RoomMeasures(
+        study_numbers=functools.partial(study_numbers, commands_per_ring=study_reference_commands),
+        grasp_rates=grasp_rates,
+    )

@@ -1,0 +1,92 @@
+"""The stick as a tool across the two backends: what pushes it, how often it can be grasped.
+
+- `push_sources`: plays a trial's first iterations (its agent and room, as `playroom run` would)
+  while watching every control step, and attributes each push of the stick (it moved while the
+  hand did not hold it) to what touched it: the hand, a toy the hand holds, a free toy.
+- `grasp_rates`: the share of random arm commands that grasp the stick from its start pose, in
+  both backends, for the very same commands: how much harder contact grasping is than the
+  study's distance rule.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import Counter
+
+import numpy as np
+
+from experiments.run.settings import TrialSettings, full_config
+from experiments.run.trial_files import fresh_trial_parts
+from models.layout import ARM_DIM, TOYS
+from sim import Playroom
+from sim import events as ev
+from sim.config import DEFAULT_WORLD
+
+# What can touch the stick, as push_sources names it.
+SOURCES = ("hand", "toy held by the hand", "free toy", "nothing")
+
+
+def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dict:
+    """Per source of SOURCES, the number of pushes of the stick and their total displacement
+    (m), over the first `iterations` of the physical trial of `seed`; and the last iteration in
+    which the hand grasped the stick, and how far the handle lay from the base at the end."""
+    config = full_config(TrialSettings(grasp="physical", seed=seed, stick_return=stick_return))
+    agent, room = fresh_trial_parts(config)
+    p = room.physics
+    stick_geoms = set(p.stick_geoms.tolist())
+    toy_geom = {int(g): TOYS[i] for i, g in enumerate(p.toy_geoms)}
+    touched: set[str] = set()
+
+    def watch(step: int, observation: dict) -> None:
+        held = room.task.grasp.hand_holds
+        if held == "stick":
+            return
+        for a, b in p.touching_pairs():
+            partner = b if a in stick_geoms else a if b in stick_geoms else None
+            if partner is None:
+                continue
+            if partner == p.hand_geom:
+                touched.add("hand")
+            elif partner in toy_geom:
+                touched.add("toy held by the hand" if toy_geom[partner] == held else "free toy")
+
+    room.step_observers.append(watch)
+    pushes: Counter[str] = Counter()
+    moved: Counter[str] = Counter()
+    last_grasp = -1
+    for iteration in range(iterations):
+        touched.clear()
+        before = p.stick_handle()
+        _, _, feedback = agent.play(room)
+        if ev.STICK_GRASPED in feedback.kinds():
+            last_grasp = iteration
+        if any(e.kind == ev.STICK_MOVED and e.by == "push" for e in feedback.events):
+            distance = float(np.linalg.norm(feedback.positions[-1, 1] - before))
+            for source in touched or {"nothing"}:
+                pushes[source] += 1
+                moved[source] += distance / max(1, len(touched))
+    return {
+        "pushes": {s: pushes[s] for s in SOURCES},
+        "pushed_metres": {s: moved[s] for s in SOURCES},
+        "last_stick_grasp": last_grasp,
+        "final_handle_distance": float(np.hypot(*p.stick_handle())),
+    }
+
+
+def grasp_rates(n_commands: int = 1000, seed: int = 0) -> dict[str, float]:
+    """Share of random arm commands that grasp the stick, per backend, each command from the
+    same scene: the stick at its start pose, the toys where the room's seed placed them."""
+    rng = np.random.default_rng(seed)
+    commands = rng.uniform(-1.0, 1.0, (n_commands, ARM_DIM))
+    start = (*DEFAULT_WORLD.stick_start_handle, DEFAULT_WORLD.stick_start_angle)
+    rates = {}
+    for grasp in ("kinematic", "physical"):
+        config = dataclasses.replace(DEFAULT_WORLD, stick_return="never")
+        room = Playroom(grasp, seed=seed, config=config)
+        toys = room.context()[2:8].reshape(3, 2)
+        grasped = 0
+        for m in commands:
+            room.arrange(stick=start, toys=toys)
+            grasped += ev.STICK_GRASPED in room.act("arm", m).kinds()
+        rates[grasp] = grasped / n_commands
+    return rates

@@ -1,0 +1,221 @@
+"""Competence and strategies as the study computed them (docs/protocol.md §10, D20-D23), its
+quirks reproduced, for comparison with the paper beside the project's own measure.
+
+How the study's code measured (its scripts/run.py and analysis notebooks):
+- tests: per ring, 100 placements of all 3 toys in the ring, one test per toy, in one scene
+  that carries over: the stick stays where the last test left it, moved toys stay moved, the
+  caregiver is redrawn after every movement and the room's own counter re-places every toy
+  every 20 movements; the goal is the toy's current position moved straight to the base;
+- strategy: the arm or the voice model of the toy, whichever has the nearer experience (a tie
+  goes to the voice); when the voice model had data, the arm model's inverse was queried with
+  the voice model's context values (toy, caregiver) in place of its own (stick, toy);
+- a test used the tool when the stick's x moved between the first and the last sample;
+- placements: drawn anew in every run (the study used the global random state), so that
+  pooled over runs the tests cover the whole disk; here from the trial's own seed;
+- random reference (notebook motor_babbling): per ring, 10000 placements, one random command
+  (arm or voice, 1/2 each) per toy as goal, so 30000 commands, whose error was read on toy 1's
+  trajectory whatever the goal toy;
+- map (notebook analysis_competence): errors pooled over runs on a 100 x 100 grid over
+  [-1, 1]^2 by the toy's position (pixel i holds x in [i/50 - 1, (i+1)/50 - 1)); the reference
+  of a pixel at pixel-distance d from pixel (50, 50) is the unweighted mean of the per-pixel
+  reference means of every pixel at a distance in (d - 1, d + 1) that holds one; per pixel
+  max(0, 1 - agent / random). How the paper's "46%" averaged the pixels is not in the study's
+  notebooks: here, the mean over every pixel that holds a test (with placements drawn anew
+  per run, about the mean over the disk);
+- strategies (Fig. 4): each pixel's shares of hand, tool and vocal tests, averaged over the
+  pixels of each radial bin int(pixel-distance) < 50 (a pixel without a test counts 0), then
+  renormalised in sequence as the notebook did (the tool share divided by a sum that already
+  holds the renormalised hand share). The curve is plotted at x = bin / 49; "distance 1" is its
+  last bin, the regions "centre" and "between the limits" its bins left of 0.6 and between
+  0.6 and 0.85 on that axis, averaged (the paper read them off the curve).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+import models
+import sim
+from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING, study_summary
+from experiments.measure.evaluation import goal_trajectory, strategy_of
+from learner.agent import Agent
+from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
+from sim import Playroom
+
+
+@dataclass(frozen=True)
+class StudyMeasureSettings:
+    n_placements: int = 100
+    random_commands_per_ring: int = RANDOM_COMMANDS_PER_RING
+    seed: int = 20170001  # the trial's seed joins it: placements differ from run to run
+
+
+def _ring_placement(room: Playroom, ring: tuple[float, float], rng) -> np.ndarray:
+    """(3, 2) toys uniform in the ring (the study's `reset_toys(region)`: no clearance)."""
+    radius = rng.uniform(*ring, size=len(TOYS))
+    angle = rng.uniform(0.0, 2 * np.pi, size=len(TOYS))
+    return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=1)
+
+
+def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
+    """A context whose arm-model slots (stick, toy) hold the voice model's values (toy,
+    caregiver): what the study's arm inverse was queried with when the voice had data."""
+    swapped = context.copy()
+    swapped[list(context_indices("stick"))] = context[list(context_indices(toy))]
+    swapped[list(context_indices(toy))] = context[list(context_indices("caregiver"))]
+    return swapped
+
+
+def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
+    """One row per test: ring, toy, x, y (the toy's position), strategy, error."""
+    rng = np.random.default_rng([settings.seed, room.seed])
+    rows = []
+    for ring_number, ring in enumerate(room.config.toy_rings, start=1):
+        for _ in range(settings.n_placements):
+            room.arrange(toys=_ring_placement(room, ring, rng))
+            for t, toy in enumerate(TOYS, start=1):
+                context = room.context()
+                position = context[list(context_indices(toy))]
+                goal = goal_trajectory(position)
+                arm, voice = agent.toy_models(t)
+                d_arm = agent.nearest_distance(arm, context, goal)
+                d_voice = agent.nearest_distance(voice, context, goal)
+                if d_arm < d_voice:
+                    asked = (
+                        context if np.isinf(d_voice) else _arm_context_of_the_study(context, toy)
+                    )
+                    space, m = "arm", agent.exploit(arm, asked, goal)
+                elif np.isfinite(d_voice):
+                    space, m = "voice", agent.exploit(voice, context, goal)
+                else:  # neither model has data: the arm at rest
+                    space, m = "arm", np.zeros(MOTOR_DIMS["arm"])
+                s = room.act(space, m).s
+                stick_x = s[block_slice("stick")][:5]
+                rows.append(
+                    {
+                        "ring": ring_number,
+                        "toy": t,
+                        "x": position[0],
+                        "y": position[1],
+                        "strategy": strategy_of(space, bool(stick_x[0] != stick_x[-1])),
+                        "error": float(np.linalg.norm(s[block_slice(toy)] - goal)),
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def random_reference(room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
+    """One row per random command: x, y of the goal toy and the error read on toy 1."""
+    rng = np.random.default_rng(settings.seed + 1)
+    rows = []
+    for ring in room.config.toy_rings:
+        for k in range(settings.random_commands_per_ring):
+            if k % len(TOYS) == 0:
+                room.arrange(toys=_ring_placement(room, ring, rng))
+            context = room.context()
+            toy = TOYS[k % len(TOYS)]
+            position = context[list(context_indices(toy))]
+            space = "arm" if rng.random() < 0.5 else "voice"
+            s = room.act(space, rng.uniform(-1, 1, MOTOR_DIMS[space])).s
+            error = float(np.linalg.norm(s[block_slice("toy1")] - goal_trajectory(position)))
+            rows.append({"x": position[0], "y": position[1], "error": error})
+    return pd.DataFrame(rows)
+
+
+# Where played random references are kept between reports: this variable if set (tests,
+# clusters whose home is small or shared), else the user's cache directory.
+CACHE_ENV = "PLAYROOM_CACHE_DIR"
+
+
+def reference_cache_dir() -> Path:
+    """Where `study_numbers` keeps the random references it played: $PLAYROOM_CACHE_DIR, else
+    the user's cache directory (platformdirs: ~/.cache/playroom on Linux). Never a batch
+    directory: a report only reads its batches, which may be read-only or shared."""
+    override = os.environ.get(CACHE_ENV)
+    if override:
+        return Path(override)
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("playroom"))
+
+
+@functools.cache
+def _code_digest() -> str:
+    """A digest of what plays a reference (this module, the room's code, model and voice
+    data): a reference kept by another version of the project is not read back as this one's."""
+    digest = hashlib.sha256(Path(__file__).read_bytes())
+    for package in (sim, models):
+        folder = Path(package.__file__).parent
+        files = (p for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
+        for path in sorted(files):
+            digest.update(str(path.relative_to(folder)).encode() + path.read_bytes())
+    return digest.hexdigest()
+
+
+def _read_kept(path: Path) -> pd.DataFrame | None:
+    from experiments import storage
+
+    try:
+        return storage.read_table(path) if path.exists() else None
+    except storage.CorruptFileError:  # damaged (a cache is not kept with care): played again
+        return None
+
+
+def _keep(path: Path, reference: pd.DataFrame) -> None:
+    """Keep a played reference, if the cache can take it: a report never fails for its cache
+    (a full or read-only cache directory only means playing the reference again next time)."""
+    from experiments import storage
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        storage.write_table(path, reference)
+    except OSError:
+        pass
+
+
+def study_numbers(
+    results,
+    commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
+    cache_dir: Path | None = None,
+) -> dict[str, dict]:
+    """`study_summary` of each group of a batch (`experiments.analysis.results.BatchResults`) whose
+    trials hold the study's tests: their tests pooled over trials (the study averaged errors
+    per pixel over its runs), against a random reference played in a fresh room of the
+    group's settings. The reference depends on the settings and the code alone: it is kept in
+    `cache_dir` (default: `reference_cache_dir()`) as `study-reference-<digest>.parquet` and
+    read back by later reports, comparisons and ablations of any batch of those settings."""
+    from experiments.run.trial_files import fresh_trial_parts
+
+    cache = Path(cache_dir) if cache_dir is not None else reference_cache_dir()
+    numbers = {}
+    for group, config in results.configs.items():
+        tests = results.study_tests[results.study_tests["group"] == group]
+        if tests.empty:
+            continue
+        config = {**config, "trial": {**config["trial"], "seed": 0}}
+        key = json.dumps(
+            {"config": config, "commands": commands_per_ring, "code": _code_digest()},
+            sort_keys=True,
+        )
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        cached = cache / f"study-reference-{digest}.parquet"
+        reference = _read_kept(cached)
+        if reference is None:
+            try:
+                _, room = fresh_trial_parts(config)
+            except ValueError:  # settings no room can be built from: the row says "not measured"
+                continue
+            settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
+            reference = random_reference(room, settings)
+            _keep(cached, reference)
+        numbers[group] = study_summary(tests, reference)
+        numbers[group]["reference_commands_per_ring"] = commands_per_ring
+    return numbers

@@ -1,0 +1,69 @@
+"""A trial evaluated after learning: the project's measure (experiments/measure/evaluation.py)
+and the study's tests (experiments/measure/study_measure.py), from the trial's final state,
+written into the trial directory as one unit (eval.json last)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from experiments import provenance, storage
+from experiments.file_names import COMPETENCE_FILE, EVAL_FILE, STUDY_TESTS_FILE, VOCAL_FILE
+from experiments.measure.evaluation import (
+    EvaluationSettings,
+    competence_table,
+    summarise_trial,
+    vocal_table,
+)
+from experiments.measure.study_measure import StudyMeasureSettings, study_tests
+from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.run.trial_checks import load_trial
+from experiments.run.trial_files import TrialError, TrialLocked
+
+
+def evaluate_trial(
+    trial_dir: str | os.PathLike, settings: EvaluationSettings | None = None, progress=False
+) -> dict:
+    """Evaluate a trial's final state and write eval.json and the tables beside it, as one
+    unit: a write that fails (disk full) leaves the trial's evaluation files as they were.
+    TrialError, before any work, for a directory that cannot be written (read-only)."""
+    settings = settings or EvaluationSettings()
+    trial_dir = Path(trial_dir)
+    config, agent, room, meta = load_trial(trial_dir)
+    # Evaluation writes into the trial directory: one writer at a time, as for the trial.
+    try:
+        lock = DirectoryLock(trial_dir).acquire()
+    except DirectoryLocked as exc:
+        raise TrialLocked(str(exc)) from None
+    except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
+        raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
+    try:
+        try:  # before minutes of tests whose results could not be kept
+            storage.check_writable(trial_dir)
+        except OSError as exc:
+            raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
+        final_state = room.get_state()  # the study's measure starts from it too
+        competence = competence_table(agent, room, settings, progress=progress)
+        vocal = vocal_table(meta["best_word_distance"], room.words.names)
+        summary = summarise_trial(config, competence, vocal)
+        summary["evaluated_at_iteration"] = int(meta["iteration"])
+        summary["n_placements"] = settings.n_placements
+        # The evaluation is computed too: its numbers carry the machine's bits as well.
+        summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
+        # The study measured in the scene learning left, carried over from test to test.
+        room.set_state(final_state)
+        study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
+        # eval.json last: it vouches for the tables (storage.write_files). A word's best
+        # distance (and so a median) is infinite until the trial's first voice movement:
+        # eval.json, standard JSON, holds null for it (experiments/analysis/results.py reads it
+        # back as infinity). The summary returned keeps the numbers.
+        files = {
+            COMPETENCE_FILE: storage.table_bytes(competence),
+            VOCAL_FILE: storage.table_bytes(vocal),
+            STUDY_TESTS_FILE: storage.table_bytes(study),
+            EVAL_FILE: storage.json_bytes(storage.finite_or_null(summary)),
+        }
+        storage.write_files(trial_dir, files)
+    finally:
+        lock.release()
+    return summary

@@ -1,0 +1,1 @@
+"""Pages and figures of batches, beside the paper's numbers (read only)."""

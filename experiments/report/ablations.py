@@ -1,0 +1,284 @@
+"""Ablations: batches that differ from a baseline batch by a setting or two, compared trial by
+trial (`playroom ablations BASELINE BATCH [BATCH ...] --out DIR`).
+
+Each row is one group of one batch (a batch of one backend has one group) set against the
+baseline's group of the same name, on the seeds both hold: the comparison is paired by seed,
+so a difference is a difference of settings, not of random draws. The baseline row is the
+baseline restricted to the seeds the ablation batches hold (e.g. seeds 0-31 of a 100-seed
+replication). A row is labelled by what its settings change from the baseline's, read from the
+trials' config.json, so the table cannot name a setting that was not changed.
+
+Numbers per row, each computed as `playroom report` computes it (experiments.analysis.stats,
+experiments.measure.study_measure): the competence and strategy shares as the study computed them,
+the project's competence with the mean paired difference from the baseline (95% interval,
+paired t test), the share of words imitated within the recognition distance, the median best
+distance of names and distractors, and the one-sided Mann-Whitney test of names below
+distractors. Written: ablations.md (the table), ablations.csv (every number, unrounded),
+ablations.png (the paired differences and the names effect, one line per row).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import textwrap
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import pandas as pd
+from matplotlib.figure import Figure
+
+from experiments import storage
+from experiments.analysis.results import BatchResults, Geometry, ReportError, check_out_dir, collect
+from experiments.analysis.room_measures import RoomMeasures
+from experiments.analysis.stats import STRATEGIES, mann_whitney, paired_difference, vocal_summary
+from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
+from experiments.report.figures import STRATEGY_COLOURS, png_bytes
+
+# How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
+BOOKKEEPING = ("trial.preset", "trial.overrides")
+# The study's regions, in the order the table shows them (experiments.measure.study_measure).
+STUDY_REGIONS = ("centre", "between_limits", "distance_1")
+
+
+@dataclass(frozen=True)
+class AblationRow:
+    """One configuration's numbers; shares are fractions, NaN where not measured."""
+
+    label: str
+    batch: str
+    group: str
+    n_trials: int
+    study_competence: float
+    study_strategies: dict[str, dict[str, float]]  # region -> strategy -> share
+    competence: float  # the project's measure, mean over trials
+    difference: float  # mean paired difference from the baseline (NaN for the baseline)
+    difference_low: float
+    difference_high: float
+    difference_p: float
+    n_pairs: int
+    words_within: float
+    median_names: float
+    median_distractors: float
+    names_below_p: float  # one-sided Mann-Whitney, names below distractors
+
+
+def describe_change(baseline: dict, config: dict) -> str:
+    """The settings that differ between two group configs, as `key: before -> after`."""
+    changes = [
+        change
+        for change in storage.config_differences(baseline, config)
+        if not any(change[0] == key or change[0].startswith(f"{key}.") for key in BOOKKEEPING)
+    ]
+    if not changes:
+        return "the baseline's settings"
+    return "; ".join(f"{key}: {before} -> {after}" for key, before, after in changes)
+
+
+def _row(
+    results: BatchResults,
+    group: str,
+    label: str,
+    measures: RoomMeasures,
+    baseline: BatchResults | None,
+) -> AblationRow:
+    results = results.select(group)
+    trials = results.trials.sort_values("seed")
+    study = measures.study_numbers(results).get(group)
+    vocal = results.vocal
+    summary = vocal_summary(vocal, Geometry.of(results).threshold)
+    names = vocal.loc[vocal["is_name"], "best_distance"]
+    distractors = vocal.loc[~vocal["is_name"], "best_distance"]
+    difference = (math.nan,) * 4
+    n_pairs = 0
+    if baseline is not None:
+        base = baseline.select(group).trials.set_index("seed")["competence_all"]
+        mine = trials.set_index("seed")["competence_all"]
+        common = sorted(set(base.index) & set(mine.index))
+        n_pairs = len(common)
+        difference = paired_difference(mine[common].to_numpy(), base[common].to_numpy())
+    return AblationRow(
+        label=label,
+        batch=results.batch_dir.name,
+        group=group,
+        n_trials=len(trials),
+        study_competence=study["competence"]["all"] if study else math.nan,
+        study_strategies=study["strategy_share"] if study else {},
+        competence=float(trials["competence_all"].mean()),
+        difference=difference[0],
+        difference_low=difference[1],
+        difference_high=difference[2],
+        difference_p=difference[3],
+        n_pairs=n_pairs,
+        words_within=summary["share_below"],
+        median_names=summary["median_names"],
+        median_distractors=summary["median_distractors"],
+        names_below_p=mann_whitney(names, distractors, alternative="less")[1],
+    )
+
+
+def ablation_rows(
+    baseline_dir: str | os.PathLike,
+    batch_dirs: list[str | os.PathLike],
+    measures: RoomMeasures,
+) -> list[AblationRow]:
+    """The baseline's row first, then one row per group of each batch that the baseline also
+    holds. ReportError (one line) for a batch that cannot be read or shares no group and no
+    seed with the baseline."""
+    if not batch_dirs:
+        raise ReportError("give at least one batch to compare with the baseline")
+    baseline = collect(baseline_dir)
+    batches = [collect(d) for d in batch_dirs]
+    seeds: set[int] = set()
+    pairs = []
+    for results in batches:
+        groups = [g for g in results.groups if g in baseline.groups]
+        if not groups:
+            raise ReportError(
+                f"{results.batch_dir} holds groups {results.groups}, the baseline "
+                f"{baseline.groups}: none in common"
+            )
+        mine = set(results.trials["seed"])
+        if not mine & set(baseline.trials["seed"]):
+            raise ReportError(f"{results.batch_dir} shares no seed with the baseline")
+        seeds |= mine
+        pairs += [(results, g) for g in groups]
+    baseline = baseline.with_seeds(seeds)
+    rows = [
+        _row(baseline, g, f"baseline ({baseline.batch_dir.name})", measures, None)
+        for g in baseline.groups
+        if any(g == group for _, group in pairs)
+    ]
+    several = len(baseline.groups) > 1
+    for results, group in pairs:
+        label = describe_change(baseline.configs[group], results.configs[group])
+        label = f"{label} [{group}]" if several else label
+        rows.append(_row(results, group, label, measures, baseline))
+    return rows
+
+
+def _percent(value: float, digits: int = 0) -> str:
+    return "n/a" if not math.isfinite(value) else f"{100 * value:.{digits}f}%"
+
+
+def _shares(row: AblationRow, region: str) -> str:
+    shares = row.study_strategies.get(region)
+    if not shares:
+        return "n/a"
+    return "/".join(f"{100 * shares.get(s, 0.0):.0f}" for s in STRATEGIES)
+
+
+def _number(value: float, form: str) -> str:
+    return "n/a" if not math.isfinite(value) else format(value, form)
+
+
+def markdown_table(rows: list[AblationRow]) -> str:
+    """The table of `ablation_rows`, in Markdown."""
+    head = (
+        "| configuration | trials | competence, study's measure | hand/tool/vocal centre | "
+        "between limits | distance 1 | competence, project's measure (paired difference "
+        "from the baseline, 95% CI, p) | words within the recognition distance | median names / "
+        "distractors | names < distractors, one-sided p |"
+    )
+    lines = [head, "|" + "---|" * 10]
+    for row in rows:
+        competence = _percent(row.competence, 1)
+        if math.isfinite(row.difference):
+            competence += (
+                f" ({100 * row.difference:+.1f} [{100 * row.difference_low:+.1f}, "
+                f"{100 * row.difference_high:+.1f}], p = {_number(row.difference_p, '.2g')}, "
+                f"{row.n_pairs} pairs)"
+            )
+        cells = [
+            row.label,
+            str(row.n_trials),
+            _percent(row.study_competence),
+            *(_shares(row, region) for region in STUDY_REGIONS),
+            competence,
+            _percent(row.words_within),
+            f"{_number(row.median_names, '.2f')} / {_number(row.median_distractors, '.2f')}",
+            _number(row.names_below_p, ".2g"),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def csv_table(rows: list[AblationRow]) -> pd.DataFrame:
+    """Every number of the rows, one column each (strategy shares flattened)."""
+    records = []
+    for row in rows:
+        record = asdict(row)
+        shares = record.pop("study_strategies")
+        for region in STUDY_REGIONS:
+            for strategy in STRATEGIES:
+                record[f"study_{region}_{strategy}"] = shares.get(region, {}).get(
+                    strategy, math.nan
+                )
+        records.append(record)
+    return pd.DataFrame(records)
+
+
+def ablation_figure(rows: list[AblationRow]) -> Figure:
+    """Left: the paired difference of the project's competence from the baseline, with its 95%
+    interval. Middle: the vocal share of each study region. Right: the names effect."""
+    fig = Figure(figsize=(14, 0.7 * len(rows) + 2.0), layout="constrained")
+    left, middle, right = fig.subplots(1, 3, sharey=True)
+    y = list(range(len(rows)))[::-1]
+    for yi, row in zip(y, rows, strict=True):
+        if math.isfinite(row.difference):
+            left.errorbar(
+                100 * row.difference,
+                yi,
+                xerr=[
+                    [100 * (row.difference - row.difference_low)],
+                    [100 * (row.difference_high - row.difference)],
+                ],
+                fmt="o",
+                color="black",
+                capsize=3,
+            )
+        for marker, region in zip("o^s", STUDY_REGIONS, strict=True):
+            share = row.study_strategies.get(region, {}).get("vocal", math.nan)
+            middle.plot(100 * share, yi, marker, color=STRATEGY_COLOURS["vocal"], label=region)
+        right.plot(row.median_names, yi, "o", color="tab:purple", label="toy names")
+        right.plot(row.median_distractors, yi, "x", color="tab:grey", label="distractors")
+    left.axvline(0.0, color="grey", linewidth=0.8)
+    left.set_yticks(y, [textwrap.fill(row.label, 50) for row in rows], fontsize=8)
+    left.set_xlabel("competence, project's measure:\ndifference from the baseline (points)")
+    middle.set_xlabel("vocal strategy share,\nstudy's measure (%)")
+    right.set_xlabel("median best distance of words\n(lower is better)")
+    for axis in (middle, right):
+        handles, labels = axis.get_legend_handles_labels()
+        unique = dict(zip(labels, handles, strict=True))
+        axis.legend(
+            unique.values(),
+            unique.keys(),
+            fontsize=8,
+            loc="lower left",
+            bbox_to_anchor=(0.0, 1.0),
+            ncols=len(unique),
+            frameon=False,
+        )
+    return fig
+
+
+def write_ablations(
+    baseline_dir: str | os.PathLike,
+    batch_dirs: list[str | os.PathLike],
+    out_dir: str | os.PathLike,
+    *,
+    measures: RoomMeasures,
+) -> Path:
+    """Compute the rows, then write the CSV, the figure and the table into out_dir as one unit
+    (after everything was computed; a failed write leaves nothing). Returns the table's path."""
+    check_out_dir(Path(out_dir))
+    rows = ablation_rows(baseline_dir, batch_dirs, measures)
+    table = markdown_table(rows)
+    figure = png_bytes(ablation_figure(rows))
+    csv = csv_table(rows).to_csv(index=False)
+    files = {
+        ABLATION_CSV_FILE: csv.encode(),
+        ABLATION_FIGURE_FILE: figure,
+        ABLATION_TABLE_FILE: table.encode(),
+    }
+    return storage.write_files(Path(out_dir), files)[-1]

@@ -1,0 +1,67 @@
+"""Reports of a batch of trials: its results beside the paper's (`playroom report DIR`) and two
+batches side by side (`playroom compare DIR_A DIR_B --out DIR`, in
+`experiments.report.comparison`).
+
+The work is split by job: `results` reads a batch directory into tables, `statistics`
+computes on them, `paper` holds the paper's published numbers, `figures` draws, and
+`report_html` renders the page from templates. Everything is computed and rendered in memory
+first and the files are then written as one unit (`storage.write_files`), so a failing report
+(bad input, a full disk) leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from experiments.analysis.results import Geometry, ReportError, check_out_dir, collect
+from experiments.analysis.room_measures import RoomMeasures
+from experiments.analysis.stats import summarise_batch
+from experiments.file_names import COMPARISON_FILE, REPORT_FILE
+from experiments.report import name_strategies, paper
+from experiments.report.comparison import write_comparison
+from experiments.report.figures import report_figures
+from experiments.report.html import render, settings_table, trials_table, where_table, write_page
+from experiments.report.study_figures import study_figure_files
+
+# The CLI imports ReportError, write_report and write_comparison from here.
+__all__ = ["COMPARISON_FILE", "REPORT_FILE", "ReportError", "write_comparison", "write_report"]
+
+
+def write_report(
+    batch_dir: str | os.PathLike,
+    out_dir: str | os.PathLike | None = None,
+    *,
+    measures: RoomMeasures,
+) -> Path:
+    """Figures (PNG) and `report.html` of a batch, its numbers beside the paper's; into
+    `out_dir` (default: the batch directory). Returns the path of report.html. ReportError
+    (one line) for a batch that cannot be reported on; nothing is written then.
+    `measures`: the study's numbers, measured in rooms (experiments.measure.for_reports)."""
+    results = collect(batch_dir)
+    out = Path(out_dir) if out_dir is not None else results.batch_dir
+    check_out_dir(out)
+    geometry = Geometry.of(results)
+    numbers = summarise_batch(results, geometry)
+    numbers["study"] = measures.study_numbers(results)
+    published = paper.published()
+    figures = report_figures(results, geometry, published["competence_all"].value)
+    figures += study_figure_files(results, published)
+    where, where_note = where_table(results)
+    page = render(
+        "report.html.j2",
+        title=f"Playroom batch report: {results.batch_dir.name}",
+        figures=figures,
+        n_trials=len(results.trials),
+        batch_dir=str(results.batch_dir),
+        settings=settings_table(results),
+        configs=results.configs,
+        paper_table=paper.paper_table(results, numbers, geometry, prefix="this batch: "),
+        paper=published,
+        reference=paper.reference(),
+        trials=trials_table(results),
+        where=where,
+        where_note=where_note,
+        **name_strategies.page_context(results, geometry.threshold),
+    )
+    return write_page(out, figures, REPORT_FILE, page)

@@ -1,0 +1,234 @@
+"""HTML of the report and the comparison: numbers turned into text, tables, and the pages
+rendered from the Jinja2 templates in `experiments/report/templates/`, then written to disk.
+
+Autoescape is on for every template: group labels, trial names, paths and configs come from
+the user's files and reach the page as text, never as markup. Figures are embedded as
+base64 PNG data URIs so that a page is one self-contained file.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
+
+from experiments import storage
+from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
+from experiments.analysis.stats import STRATEGIES
+from experiments.report.figures import FigureFile
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of plain-text cells: header (n columns) and rows (lists of n strings)."""
+
+    header: list[str]
+    rows: list[list[str]]
+
+
+# Numbers as text ------------------------------------------------------------------------------
+
+
+def pct(x: float, digits: int = 0) -> str:
+    """A fraction as a percentage ("46%"); "n/a" for NaN or inf."""
+    return "n/a" if not np.isfinite(x) else f"{100 * x:.{digits}f}%"
+
+
+def num(x: float, digits: int = 2) -> str:
+    """A number with `digits` decimals; "n/a" for NaN or inf."""
+    return "n/a" if not np.isfinite(x) else f"{x:.{digits}f}"
+
+
+def p_value(p: float) -> str:
+    """A p value as text: 3 decimals, or 2 significant digits below 0.001 (not "0.000")."""
+    if not np.isfinite(p):
+        return "n/a"
+    return f"p = {p:.3f}" if p >= 1e-3 else f"p = {p:.1e}"
+
+
+def ci_text(row: pd.Series) -> str:
+    """A row of `statistics.competence_summary` as "mean [95% CI low, high] (n=...)"."""
+    if not np.isfinite(row["mean"]):
+        return "n/a"
+    if not np.isfinite(row["low"]):
+        return f"{pct(row['mean'], 1)} (n={row['n']}, no interval)"
+    interval = f"[95% CI {pct(row['low'], 1)}, {pct(row['high'], 1)}]"
+    return f"{pct(row['mean'], 1)} {interval} (n={row['n']})"
+
+
+def shares_text(row: pd.Series) -> str:
+    """A row of `statistics.strategy_table` as "hand / tool / vocal (n=... tests)"."""
+    if row["n"] == 0:
+        return "no tests here"
+    shares = " / ".join(pct(row[s]) for s in STRATEGIES)
+    return f"{shares} (n={row['n']} tests)"
+
+
+def seeds_text(seeds: list[int]) -> str:
+    """Seeds as a range ("0–9") when they are consecutive, else listed."""
+    seeds = sorted(seeds)
+    if seeds == list(range(seeds[0], seeds[-1] + 1)) and len(seeds) > 2:
+        return f"{seeds[0]}–{seeds[-1]}"
+    return ", ".join(map(str, seeds))
+
+
+# Tables shared by the report and the comparison -----------------------------------------------
+
+
+def settings_table(results: BatchResults) -> Table:
+    """One row per group: trials, seeds, iterations, babbling, placements, package version."""
+    rows = []
+    for group in results.groups:
+        trials = results.trials[results.trials["group"] == group]
+        config = results.configs[group]
+        rows.append(
+            [
+                group,
+                str(len(trials)),
+                seeds_text(trials["seed"].tolist()),
+                str(config["trial"]["iterations"]),
+                str(config["trial"]["babbling"]),
+                str(trials["n_placements"].iloc[0]),
+                str(config.get("package_version", "?")),
+            ]
+        )
+    header = [
+        "group",
+        "trials",
+        "seeds",
+        "iterations",
+        "babbling",
+        "placements per ring",
+        "package version",
+    ]
+    return Table(header, rows)
+
+
+def trials_table(results: BatchResults) -> Table:
+    """One row per trial: its competence, vocal numbers, diverged iterations and cost."""
+    rows = [
+        [
+            r["trial"],
+            r["group"],
+            str(r["seed"]),
+            *[pct(r[f"competence_{k}"], 1) for k in COMPETENCE_SCOPES],
+            pct(r["share_below_threshold"]),
+            num(r["median_names"]),
+            num(r["median_distractors"]),
+            str(r["diverged"]),
+            num(r["seconds"] / r["timed_iterations"], 4),
+        ]
+        for _, r in results.trials.iterrows()
+    ]
+    header = [
+        "trial",
+        "group",
+        "seed",
+        "competence",
+        "ring 1",
+        "ring 2",
+        "ring 3",
+        "words < threshold",
+        "median names",
+        "median distractors",
+        "diverged",
+        "s / iteration",
+    ]
+    return Table(header, rows)
+
+
+# Rows of BatchResults.provenance: who computed a trial, who evaluated it.
+ROLES = ("computed", "evaluated")
+
+
+def _counts_text(rows: pd.DataFrame, groups: list[str]) -> str:
+    """How many distinct trials `rows` hold, per group when the page shows several."""
+    n = rows["trial"].nunique()
+    if n == 0 or len(groups) < 2:
+        return str(n)
+    per = [f"{g} {rows.loc[rows['group'] == g, 'trial'].nunique()}" for g in groups]
+    return f"{n} ({', '.join(p for p in per if not p.endswith(' 0'))})"
+
+
+def where_table(results: BatchResults) -> tuple[Table, str]:
+    """Where the trials ran: one row per machine and library set (CPU, NumPy's SIMD, BLAS
+    kernel, numpy and mujoco versions, host, commit) with the trials computed and evaluated
+    there; trials from before provenance was recorded count as "not recorded". Returns the
+    table and a sentence about trials computed on more than one machine."""
+    from experiments.provenance import SHORT_FIELDS
+
+    where = results.provenance
+    if "status" not in where:  # results built without it (none read from a batch)
+        return Table([], []), "Not recorded."
+    header = ["CPU", "NumPy SIMD", "BLAS (kernel)", "numpy", "mujoco", "host", "commit"]
+    header += [f"trials {role}" for role in ROLES]
+    unknown = {"not recorded": "not recorded (older trials)", "unreadable": "record unreadable"}
+    rows = []
+    # Recorded machines first, in the order trials were read; unknown ones last.
+    groups = where.groupby(["status", *SHORT_FIELDS], sort=False)
+    for values, here in sorted(groups, key=lambda g: g[0][0] != "recorded"):
+        status, *fields = values
+        if status != "recorded":
+            fields = [unknown.get(status, status)] + [""] * (len(SHORT_FIELDS) - 1)
+        counts = [_counts_text(here[here["role"] == role], results.groups) for role in ROLES]
+        rows.append([*fields, *counts])
+    computed = where[where["role"] == "computed"]
+    moved = int((computed.groupby("trial").size() > 1).sum())
+    note = (
+        f"{moved} trial{'s' if moved != 1 else ''} changed machine or library set on a resume "
+        f"and count{'' if moved != 1 else 's'} under each."
+        if moved
+        else "Each trial was computed on one machine and library set."
+    )
+    return Table(header, rows), note
+
+
+# Pages -----------------------------------------------------------------------------------------
+
+
+def _data_uri(png: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+def _pretty_json(obj: Any) -> str:
+    return json.dumps(obj, indent=2, sort_keys=True)
+
+
+def _environment() -> Environment:
+    env = Environment(
+        loader=PackageLoader("experiments.report", "templates"),
+        # Every template here is HTML; default=True also escapes any template named otherwise.
+        autoescape=select_autoescape(enabled_extensions=("html.j2",), default=True),
+        # A misspelt variable fails the report instead of leaving a blank in it.
+        undefined=StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+    env.filters["data_uri"] = _data_uri
+    env.filters["pretty_json"] = _pretty_json
+    return env
+
+
+_ENV = _environment()
+
+
+def render(template: str, **context: Any) -> str:
+    """The page of `template` (a file name in experiments/report/templates/) filled with
+    `context`."""
+    return _ENV.get_template(template).render(**context)
+
+
+def write_page(out_dir: Path, figures: list[FigureFile], page_name: str, page: str) -> Path:
+    """The PNGs and the page as one unit (`storage.write_files`), the page last: a write that
+    fails (disk full) leaves nothing, and a page on disk means its figures are there too.
+    Returns the page's path."""
+    files = {figure.name: figure.png for figure in figures}
+    files[page_name] = page.encode("utf-8")
+    return storage.write_files(out_dir, files)[-1]

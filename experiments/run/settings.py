@@ -1,0 +1,178 @@
+"""What a user chooses for one trial, checked before anything is written.
+
+`TrialSettings` are the choices of `playroom run` (and of each trial of a batch); `full_config`
+makes every setting of the trial from them, as config.json holds it, and checks every value
+(the configs check their own fields: sim/config.py, sim/vocal/config.py, learner/config.py).
+`resume_settings` gives the settings of `playroom run --resume`: the trial's own, read from its
+config.json, which settings given on the command line must match.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+from experiments import storage
+from experiments.file_names import CONFIG_FILE
+from experiments.run.trial_files import TrialError
+from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
+from sim.config import PRESETS, STICK_RETURNS, WorldConfig, world_preset
+from sim.physics import PlayroomPhysics
+from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
+
+GRASPS = ("kinematic", "physical")
+
+
+@dataclass(frozen=True)
+class TrialSettings:
+    """What a user chooses for one trial (`playroom run`)."""
+
+    grasp: str = "kinematic"
+    iterations: int = 1000
+    seed: int = 0
+    babbling: str = "random"
+    checkpoint_every: int = 1000
+    stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
+    # "study": the world and learner as the study's code behaved; "project": this project's
+    # earlier choices (sim.config.world_preset, learner.config.learner_preset).
+    preset: str = "study"
+    # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
+    # departure switched at a time (ablations, docs/replication.md).
+    overrides: dict = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.grasp not in GRASPS:
+            raise TrialError(f"unknown grasp {self.grasp!r}: one of {', '.join(GRASPS)}")
+        if self.preset not in PRESETS:
+            raise TrialError(f"unknown preset {self.preset!r}: one of {', '.join(PRESETS)}")
+        if self.babbling not in BABBLING_MODES:
+            raise TrialError(
+                f"unknown babbling {self.babbling!r}: one of {', '.join(BABBLING_MODES)}"
+            )
+        _check_overrides(self.overrides)
+        if self.stick_return not in STICK_RETURNS:
+            raise TrialError(
+                f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
+            )
+        for name in ("iterations", "checkpoint_every"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+                raise TrialError(f"{name} must be a positive integer, got {value!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise TrialError(f"seed must be a non-negative integer, got {self.seed!r}")
+
+
+# Override sections, their configs, and the fields a trial setting owns: an override of one
+# would make config.json's "trial" section say something else than the world or learner does.
+OVERRIDABLE = {"world": (WorldConfig, "stick_return"), "learner": (LearnerConfig, "babbling")}
+
+
+def _check_overrides(overrides: object) -> None:
+    """The overrides' shape and names (their values are checked by the configs themselves)."""
+    if not isinstance(overrides, dict):
+        raise TrialError(
+            f"overrides must be {{'world': {{...}}, 'learner': {{...}}}}, got {overrides!r}"
+        )
+    unknown = sorted(set(overrides) - set(OVERRIDABLE))
+    if unknown:
+        raise TrialError(f"overrides of unknown sections {unknown}: 'world' or 'learner'")
+    for section, values in overrides.items():
+        cls, owned = OVERRIDABLE[section]
+        if not isinstance(values, dict):
+            raise TrialError(f"overrides.{section} must be an object of settings, got {values!r}")
+        known = {f.name for f in dataclasses.fields(cls)} - {owned}
+        unknown = sorted(set(values) - known)
+        if owned in values:
+            raise TrialError(
+                f"overrides.{section}.{owned} is the trial setting {owned}: set that instead"
+            )
+        if unknown:
+            raise TrialError(
+                f"overrides.{section}: unknown settings {', '.join(map(str, unknown))} "
+                f"(known: {', '.join(sorted(known))})"
+            )
+
+
+def full_config(
+    settings: TrialSettings,
+    world: WorldConfig | None = None,
+    voice: VoiceConfig = DEFAULT_VOICE,
+    learner: LearnerConfig | None = None,
+) -> dict:
+    """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
+    the trial's room and agent from. Every value is checked here, before a trial writes
+    anything: TrialError (one line) naming the setting and what it allows."""
+    changes = settings.overrides
+    try:
+        learner = learner or learner_preset(
+            settings.preset, **{"babbling": settings.babbling, **changes.get("learner", {})}
+        )
+        world = world or world_preset(
+            settings.preset, **{"stick_return": settings.stick_return, **changes.get("world", {})}
+        )
+        # The MJCF's lengths must equal the world's (sim/physics.py): refused now rather than
+        # when the room is built, after config.json is written. A load costs milliseconds.
+        PlayroomPhysics.load(world)
+    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
+        raise TrialError(f"overrides do not fit the configs: {exc}") from None
+    config = {
+        "trial": dataclasses.asdict(settings),
+        "world": dataclasses.asdict(world),
+        "voice": dataclasses.asdict(voice),
+        "learner": learner.to_dict(),
+        "package_version": version("playroom"),
+    }
+    # Through JSON and back, so that it compares equal to what config.json holds; strict JSON
+    # (no NaN or Infinity), as storage.write_json writes it.
+    return json.loads(json.dumps(config, allow_nan=False))
+
+
+def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialSettings:
+    """The settings a resumed trial runs with (`playroom run --resume`): those stored in its
+    config.json, overrides included. `given` holds the settings the user gave explicitly;
+    each must match the stored one, except a larger `iterations`, which extends the trial.
+    TrialError, one line: no trial to resume in `out_dir`, or every mismatch at once."""
+    names = [f.name for f in dataclasses.fields(TrialSettings) if f.name != "overrides"]
+    unknown = sorted(set(given) - set(names))
+    if unknown:
+        raise TrialError(f"unknown trial settings {unknown}: one of {', '.join(names)}")
+    stored = stored_settings(out_dir)
+    dataclasses.replace(stored, **given)  # each given value checked on its own first
+    mismatches = []
+    for name, value in given.items():
+        have = getattr(stored, name)
+        option = "--" + name.replace("_", "-")  # as `playroom run` names it
+        if name == "iterations" and value < have:
+            mismatches.append(f"{option} {value} (it has {have}; only a larger number extends it)")
+        elif name != "iterations" and value != have:
+            mismatches.append(f"{option} {value} (it has {have})")
+    if mismatches:
+        raise TrialError(
+            f"{out_dir} holds a trial of another configuration: {'; '.join(mismatches)}; "
+            "leave these settings out to resume it as it is"
+        )
+    return dataclasses.replace(stored, iterations=given.get("iterations", stored.iterations))
+
+
+def stored_settings(out_dir: str | os.PathLike) -> TrialSettings:
+    """The TrialSettings a trial directory's config.json holds; TrialError when there is none."""
+    path = Path(out_dir) / CONFIG_FILE
+    if not Path(out_dir).is_dir():
+        why = "not a directory" if Path(out_dir).exists() else "no such directory"
+        raise TrialError(f"no trial to resume in {out_dir}: {why}")
+    if not path.is_file():
+        raise TrialError(f"no trial to resume in {out_dir}: it holds no {CONFIG_FILE}")
+    config = storage.read_json(path)
+    trial = config.get("trial") if isinstance(config, dict) else None
+    if not isinstance(trial, dict):
+        raise TrialError(f'{path} holds no trial settings (no "trial" section)')
+    known = {f.name for f in dataclasses.fields(TrialSettings)}
+    unknown = sorted(set(trial) - known)
+    if unknown:
+        raise TrialError(f"{path} holds unknown trial settings: {', '.join(unknown)}")
+    return TrialSettings(**trial)

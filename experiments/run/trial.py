@@ -1,0 +1,293 @@
+"""One trial: the Model Babbling agent playing in one room, written to a directory that
+survives being killed (its files: experiments/run/trial_files.py).
+
+Each file is written atomically, and a log chunk is always written before the checkpoint that
+covers it, so a run killed at any moment resumes from its last checkpoint and rewrites the same
+chunks: the final memory and logs equal those of an uninterrupted run.
+
+One process writes into a trial directory at a time (experiments/run/lock.py). Resuming with more
+iterations than the trial was asked for extends it: the result equals a run asked for the
+larger number from the start, and files derived from the shorter run (its evaluation) are
+moved aside into `stale-at-NNNNNNNN/`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from experiments import provenance, storage
+from experiments.file_names import (
+    CHECKPOINT_FILE,
+    CONFIG_FILE,
+    LOCK_FILE,
+    LOG_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+    STALE_PREFIX,
+    TRIAL_ENTRIES,
+)
+from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.run.settings import TrialSettings, full_config
+from experiments.run.trial_checks import drop_logs_past, prepare_resume
+from experiments.run.trial_files import (
+    EXTENSIBLE,
+    WORDS_LOG_PERIOD,
+    TrialError,
+    TrialLocked,
+    fresh_trial_parts,
+    log_row,
+    trial_identity,
+)
+from models.layout import TOYS, block_slice
+from sim.vocal.words import word_distances
+
+
+class Trial:
+    """A trial directory and the loop that fills it. It holds the directory's lock from its
+    creation until `close` (or the end of the process)."""
+
+    def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
+        self.dir = Path(out_dir)
+        self.settings = settings
+        self.config = full_config(settings)
+        self.notices: list[str] = []  # one line each: what a resume had to do
+        self._refuse_foreign_path()
+        try:
+            self._lock = DirectoryLock(self.dir).acquire()
+        except DirectoryLocked as exc:
+            raise TrialLocked(str(exc)) from None
+        except OSError as exc:
+            raise TrialError(f"cannot write into {self.dir}: {exc.strerror}") from None
+        try:
+            self._check_directory(resume)
+            self.agent, self.room = fresh_trial_parts(self.config)
+            self.iteration = 0
+            self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
+            self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
+            self.elapsed: float | None = None  # seconds of the last `run_trial`
+            self.start_iteration = 0
+            if resume:
+                self._resume()
+            if not self.finished:  # who computes from here on (provenance.json)
+                self.notices += provenance.record_start(self.dir, self.iteration)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Give up the directory's lock."""
+        self._lock.release()
+
+    # Directory rules ----------------------------------------------------------------------
+    def _refuse_foreign_path(self) -> None:
+        """Before anything is written: a file, or a folder of something else, is refused."""
+        d = self.dir
+        if d.exists() and not d.is_dir():
+            raise TrialError(f"{d} is a file, not a directory")
+        if d.is_dir() and not (d / CONFIG_FILE).exists():
+            if any(p.name != LOCK_FILE for p in d.iterdir()):
+                raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
+
+    def _check_directory(self, resume: bool) -> None:
+        d = self.dir
+        config_path = d / CONFIG_FILE
+        if config_path.exists():
+            if not resume:
+                raise TrialError(
+                    f"{d} already holds a trial; add --resume to continue it, or choose a new "
+                    "directory"
+                )
+            diff = [
+                f"{key}: {a!r} != {b!r}"
+                for key, a, b in storage.config_differences(
+                    storage.read_json(config_path), self.config
+                )
+                if key not in EXTENSIBLE
+            ]
+            if diff:
+                raise TrialError(
+                    f"{d} holds a trial of another configuration ({'; '.join(diff[:4])}); "
+                    "refusing to mix them"
+                )
+        try:
+            (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
+            probe = d / ".write-test"
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as exc:
+            raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
+        if not config_path.exists():
+            try:
+                storage.write_json(config_path, self.config)
+            except OSError:
+                # A new trial whose first file cannot be written (disk full) leaves its folder
+                # as it found it, so that the same command can start it later.
+                with contextlib.suppress(OSError):
+                    (d / LOG_DIR).rmdir()  # made just above; empty, or rmdir refuses
+                raise
+
+    @property
+    def finished(self) -> bool:
+        return self.iteration >= self.settings.iterations
+
+    # Checkpoints --------------------------------------------------------------------------
+    def _save_checkpoint(self) -> None:
+        room_state = self.room.get_state()
+        # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
+        arrays = {f"agent/{k}": v for k, v in self.agent.state_dict().items()}
+        arrays["room/physics"] = room_state.pop("physics")
+        arrays["best_word_distance"] = self.best_word_distance
+        meta = {
+            "iteration": self.iteration,
+            "finished": self.finished,
+            "room": room_state,
+            "counts": self.counts,
+            # Whose checkpoint it is: one copied into another trial is refused there.
+            "identity": trial_identity(self.config),
+        }
+        newest = self.dir / CHECKPOINT_FILE
+        if newest.exists():
+            # Killed between these two lines, the trial still has the previous checkpoint.
+            os.replace(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
+        storage.write_arrays(newest, arrays, meta)
+
+    def _resume(self) -> None:
+        """Load the newest usable checkpoint (its logs checked before anything is changed),
+        drop the logs past it and the litter of killed writers, and extend the trial if more
+        iterations are asked for than it was run with."""
+        restored = prepare_resume(self.dir, self.config, self.notices)
+        if restored is not None:
+            self.agent, self.room, meta = restored
+            self.iteration = int(meta["iteration"])
+            self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
+            self.counts = dict(meta["counts"])
+        drop_logs_past(self.dir, self.iteration)  # the lost work's: rewritten by the run
+        self._extend_if_asked()
+
+    def _extend_if_asked(self) -> None:
+        config_path = self.dir / CONFIG_FILE
+        stored = storage.read_json(config_path)
+        asked, stored_total = self.settings.iterations, stored["trial"]["iterations"]
+        if asked == stored_total:
+            return
+        if asked < self.iteration:
+            raise TrialError(
+                f"{self.dir} holds {self.iteration} iterations already; --iterations {asked} "
+                "would shorten it"
+            )
+        stale = self.dir / f"{STALE_PREFIX}{self.iteration:08d}"
+        # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a
+        # writer (one `remove_litter` spared): none is a result derived from the trial.
+        derived = [
+            p
+            for p in self.dir.iterdir()
+            if p.name not in TRIAL_ENTRIES
+            and not p.name.startswith(STALE_PREFIX)
+            and storage.temporary_writer(p.name) is None
+        ]
+        if derived:
+            stale.mkdir(exist_ok=True)
+            for path in derived:
+                shutil.move(path, stale / path.name)
+            self.notices.append(
+                f"extended from {stored_total} to {asked} iterations; the shorter run's "
+                f"{', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"
+            )
+        storage.write_json(config_path, self.config)
+
+    # The loop -----------------------------------------------------------------------------
+    def run(self, progress: bool = True) -> None:
+        """Run until `iterations`, checkpointing every `checkpoint_every` iterations."""
+        total = self.settings.iterations
+        # `with`: the bar's line is ended however the run ends (Ctrl-C, disk full), before
+        # the command's last line.
+        with tqdm(
+            total=total,
+            initial=self.iteration,
+            disable=not progress,
+            unit="it",
+            desc=f"{self.settings.grasp} seed {self.settings.seed}",
+            dynamic_ncols=True,
+        ) as bar:
+            self._run_to(total, bar)
+            bar.set_postfix(self.counts)
+
+    def _run_to(self, total: int, bar: tqdm) -> None:
+        """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
+        if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
+            # A checkpoint before the first log chunk: a directory with logs then always has
+            # a checkpoint, unless it was lost, and a resume can tell which (`_resume`).
+            self._save_checkpoint()
+        rows: list[dict] = []
+        word_rows: list[dict] = []
+        chunk_start = self.iteration
+        while self.iteration < total:
+            rows.append(self._iterate())
+            self.iteration += 1
+            if self.iteration % WORDS_LOG_PERIOD == 0:
+                word_rows.append(self._word_row())
+            bar.update(1)
+            if self.iteration % 50 == 0:
+                bar.set_postfix(self.counts, refresh=False)
+            if self.iteration % self.settings.checkpoint_every == 0 or self.iteration == total:
+                self._write_logs(chunk_start, rows, word_rows)
+                self._save_checkpoint()
+                rows, word_rows, chunk_start = [], [], self.iteration
+
+    def _iterate(self) -> dict:
+        proposal, context, feedback = self.agent.play(self.room)
+        if proposal.motor_space == "voice":
+            sound = feedback.s[block_slice("sound")]
+            distances = word_distances(sound, self.room.vocal_tract.config)
+            np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
+        row = log_row(self.iteration, proposal, feedback, context)
+        self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)
+        self.counts["words_recognised"] += row["word_recognised"] != ""
+        self.counts["diverged"] += row["diverged"]
+        self.counts["stick_returns"] += row["stick_returned"]
+        return row
+
+    def _word_row(self) -> dict:
+        row = {"iteration": self.iteration}
+        words = self.room.vocal_tract.config.words
+        for word, best in zip(words, self.best_word_distance, strict=True):
+            row[word] = float(best)
+        return row
+
+    def _write_logs(self, start: int, rows: list[dict], word_rows: list[dict]) -> None:
+        log = self.dir / LOG_DIR
+        storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
+        if word_rows:
+            storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+
+
+def run_trial(
+    out_dir: str | os.PathLike,
+    settings: TrialSettings,
+    resume: bool = False,
+    progress: bool = True,
+    notify: Callable[[str], None] | None = None,
+) -> Trial:
+    """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
+    the run, with each line a resume has to report (a fallback checkpoint, an extension)."""
+    trial = Trial(out_dir, settings, resume=resume)
+    for notice in trial.notices if notify is not None else ():
+        notify(notice)
+    try:
+        if trial.finished:
+            return trial
+        trial.start_iteration = trial.iteration
+        start = time.perf_counter()
+        trial.run(progress=progress)
+        trial.elapsed = time.perf_counter() - start
+    finally:
+        trial.close()
+    return trial

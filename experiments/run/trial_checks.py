@@ -1,0 +1,237 @@
+"""Reading a trial directory back only when it is whole, and saying truly what is not.
+
+- A checkpoint is used only if it is the trial's own (its identity, trial_files.trial_identity)
+  and readable; the newest is preferred, the previous one is the fallback of a resume only.
+- The log chunks a checkpoint covers must be present and hold what their names say: a lost
+  chunk cannot be regenerated (except by running the trial again from scratch), so whatever
+  finds one stops, names it, and changes nothing.
+- Temporary files of writers killed mid-write are litter, removed by a resume, never results.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+from experiments import storage
+from experiments.file_names import (
+    CHECKPOINT_FILE,
+    CONFIG_FILE,
+    DAMAGED_CHECKPOINT_FILE,
+    LOG_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+)
+from experiments.run.trial_files import (
+    WORDS_LOG_PERIOD,
+    TrialError,
+    fresh_trial_parts,
+    restore_checkpoint,
+)
+from learner.agent import Agent
+from sim import Playroom
+
+# A log chunk: its kind and the iteration it starts at.
+_CHUNK = re.compile(r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parquet")
+
+
+def restore_newest(
+    trial_dir: str | os.PathLike, config: dict
+) -> tuple[Agent, Playroom, dict, str | None]:
+    """A trial's newest usable checkpoint, restored into fresh parts: (agent, room, meta,
+    fallback), `fallback` None when checkpoint.npz was used, else one line saying what is
+    wrong with it (missing, or damaged). TrialError if neither checkpoint can be used (naming
+    both, and what is wrong with each), or if the one read belongs to another trial."""
+    trial_dir = Path(trial_dir)
+    problems = []
+    for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
+        # A restore that failed half-way may have changed them: each try starts afresh.
+        agent, room = fresh_trial_parts(config)
+        try:
+            meta = restore_checkpoint(trial_dir, agent, room, name, config=config)
+        except storage.CorruptFileError as exc:
+            problems.append(" ".join(str(exc).split()))
+            continue
+        return agent, room, meta, (problems[0] if problems else None)
+    raise TrialError(
+        f"{trial_dir} cannot be restored: {problems[0]}; {problems[1]}. Nothing was changed: "
+        "a trial without a readable checkpoint can only be run again from scratch, into a new "
+        "directory"
+    )
+
+
+def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
+    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta).
+    TrialError unless its newest checkpoint is its own and readable and its logs up to it
+    whole: what is derived from it (an evaluation, a report) would not be the trial's."""
+    trial_dir = Path(trial_dir)
+    if not (trial_dir / CONFIG_FILE).exists():
+        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
+        raise TrialError(f"{trial_dir} has no checkpoint yet")
+    config = storage.read_json(trial_dir / CONFIG_FILE)
+    agent, room, meta, fallback = restore_newest(trial_dir, config)
+    if fallback is not None:
+        # Only the resume may fall back: it rewrites the logs past the previous checkpoint.
+        raise TrialError(
+            f"{fallback}; `playroom run --out {trial_dir} --resume` continues the trial from "
+            f"{PREVIOUS_CHECKPOINT_FILE} (iteration {meta['iteration']}), then evaluate it"
+        )
+    if meta["iteration"] == 0:
+        raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
+    check_logs(trial_dir, int(meta["iteration"]))
+    return config, agent, room, meta
+
+
+def log_chunk_start(path: Path) -> int | None:
+    """The iteration a log chunk starts at; None if `path` is not named as a log chunk."""
+    match = _CHUNK.fullmatch(path.name)
+    return None if match is None else int(match["start"])
+
+
+def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
+    """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
+    is missing, unreadable, or holds other rows than its name and period say: the iterations
+    chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
+    WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later
+    are work past the checkpoint (a resume rewrites them) and are not looked at."""
+    log = Path(trial_dir) / LOG_DIR
+    found = {"iterations": {}, "words": {}}
+    for path in log.glob("*.parquet"):
+        start = log_chunk_start(path)
+        if start is not None and start < iteration:
+            found[_CHUNK.fullmatch(path.name)["kind"]][start] = path
+    start = 0
+    while start < iteration:
+        path = log / f"iterations-{start:08d}.parquet"
+        if start not in found["iterations"]:
+            end = min((s for s in found["iterations"] if s > start), default=iteration)
+            raise TrialError(_lost(f"{path} is missing (iterations {start} to {end - 1})"))
+        end = start + _check_rows(path, range(start, iteration), whole=False)
+        # The words rows this period reached: the multiples of the period in (start, end].
+        reached = range(
+            (start // WORDS_LOG_PERIOD + 1) * WORDS_LOG_PERIOD, end + 1, WORDS_LOG_PERIOD
+        )
+        words = found["words"].pop(start, log / f"words-{start:08d}.parquet")
+        if reached and not words.exists():
+            raise TrialError(_lost(f"{words} is missing (words at {reached[0]} to {reached[-1]})"))
+        if words.exists():
+            _check_rows(words, reached, whole=True)
+        start = end
+    for words in found["words"].values():
+        raise TrialError(_lost(f"{words} starts where no iterations chunk starts"))
+
+
+def _check_rows(path: Path, expected: range, whole: bool) -> int:
+    """The number of rows of a log chunk, whose iterations must be the first of `expected`
+    (all of them if `whole`); TrialError naming the chunk otherwise."""
+    try:
+        rows = storage.read_column(path, "iteration")
+    except storage.CorruptFileError as exc:
+        raise TrialError(_lost(_first_line(exc))) from None
+    if not rows or rows != list(expected[: len(rows)]) or (whole and len(rows) != len(expected)):
+        wanted = f"iterations {expected[0]} on" if expected else "no rows"
+        raise TrialError(_lost(f"{path} does not hold what its name says ({wanted})"))
+    return len(rows)
+
+
+def _first_line(exc: Exception) -> str:
+    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+
+
+def _lost(problem: str) -> str:
+    """One line: a log chunk that is not whole (`problem` names it), and the only ways back."""
+    return (
+        f"{problem}: the logs of a trial cannot be regenerated except by running it again "
+        "from scratch (into a new directory, with the settings in its config.json) or restored "
+        "from a backup; nothing was changed"
+    )
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process `pid` runs on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        return True
+    return True
+
+
+def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
+    """Remove the temporary files that writers killed mid-write (storage.write_bytes) left in a
+    trial directory and its log/; returns their names (relative to the directory).
+
+    Called under the directory's lock: every writer of the trial's own files (run, eval, a
+    batch task) holds it, so such a file there was left by a dead writer. A live process is
+    still spared: a writer that takes no lock (a video rendered into the directory) may own
+    it. A spared file is never taken for a result either (experiments/run/trial.py's derived
+    files leave temporary files out)."""
+    trial_dir = Path(trial_dir)
+    removed = []
+    for folder in (trial_dir, trial_dir / LOG_DIR):
+        for path in sorted(folder.glob(".*.tmp")):
+            pid = storage.temporary_writer(path.name)
+            if pid is not None and not _alive(pid):
+                path.unlink(missing_ok=True)
+                removed.append(str(path.relative_to(trial_dir)))
+    return removed
+
+
+def prepare_resume(
+    trial_dir: Path, config: dict, notices: list[str]
+) -> tuple[Agent, Playroom, dict] | None:
+    """What a resume starts from: (agent, room, checkpoint meta) of the newest usable
+    checkpoint whose logs are whole, or None to start from iteration 0 (no checkpoint and no
+    logs yet). Everything is checked before anything is changed; then a damaged newest
+    checkpoint is kept as checkpoint.damaged.npz and the litter of killed writers removed.
+    Appends to `notices` one line per thing done or noticed. TrialError if the trial cannot
+    be resumed (the message says why and what can be done)."""
+    newest = trial_dir / CHECKPOINT_FILE
+    if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
+        # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
+        # trial.py): logs without one are a trial whose checkpoints were lost.
+        chunks = [p for p in (trial_dir / LOG_DIR).glob("*") if log_chunk_start(p) is not None]
+        if chunks:
+            raise TrialError(
+                f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint "
+                f"({CHECKPOINT_FILE} and {PREVIOUS_CHECKPOINT_FILE} are missing): resuming "
+                "would restart it from iteration 0 and delete its logs; refusing. Restore the "
+                "checkpoints, or run the trial again from scratch into a new directory"
+            )
+        notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
+        restored = None
+    else:
+        agent, room, meta, fallback = restore_newest(trial_dir, config)
+        check_logs(trial_dir, int(meta["iteration"]))
+        restored = agent, room, meta
+        if "identity" not in meta:
+            notices.append(
+                "the checkpoint predates trial identities (no seed or config hash in it): "
+                "taken as this trial's; the next checkpoint carries one"
+            )
+        if fallback is not None:
+            kept = ""
+            if newest.exists():  # damaged, not missing: kept for whoever looks into it
+                os.replace(newest, trial_dir / DAMAGED_CHECKPOINT_FILE)
+                kept = f" (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
+            notices.append(
+                f"{fallback}; resumed from the previous checkpoint ({PREVIOUS_CHECKPOINT_FILE}), "
+                f"at iteration {meta['iteration']}{kept}"
+            )
+    litter = remove_litter(trial_dir)
+    if litter:
+        notices.append(
+            f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
+        )
+    return restored
+
+
+def drop_logs_past(trial_dir: Path, iteration: int) -> None:
+    """Delete the log chunks that start at `iteration` or later: the work past a checkpoint,
+    which the resumed run rewrites."""
+    for chunk in (trial_dir / LOG_DIR).glob("*.parquet"):
+        start = log_chunk_start(chunk)
+        if start is not None and start >= iteration:
+            chunk.unlink()

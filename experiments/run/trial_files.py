@@ -1,0 +1,181 @@
+"""What a trial directory holds, and how it is read back.
+
+A trial directory holds:
+- `config.json`: every setting (trial, world, voice, learner), the package version, the seed;
+- `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
+  every `checkpoint_every` iterations and at the end, with the one before it kept beside it
+  as `checkpoint.prev.npz`: a damaged newest checkpoint costs at most two periods;
+- `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
+  one file per checkpoint period, starting at iteration NNNNNNNN;
+- `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
+  of the 6 words, in the chunk of the period that reaches them;
+- `provenance.json`: the machine, libraries and commit that computed each stretch of
+  iterations, one entry per run or resume (experiments/provenance.py);
+- `.lock`: the lock of its one writer (experiments/run/lock.py).
+Everything else in it (evaluation, timing, videos) is derived from the trial at some iteration.
+The writer is experiments/run/trial.py; experiments/run/trial_checks.py reads a trial back only
+when it is whole (its checkpoint its own and readable, the logs it covers complete).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from experiments import storage
+from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
+from learner.agent import Agent
+from learner.config import LearnerConfig
+from models.layout import TOYS, context_indices
+from sim import Playroom
+from sim import events as ev
+from sim.config import WorldConfig, config_from_dict
+from sim.vocal.config import VoiceConfig
+
+# Iterations between two rows of the words log: the vocal learning curves are read every 100
+# iterations (docs/protocol.md §10).
+WORDS_LOG_PERIOD = 100
+
+# Settings a resume may change: a trial can be extended to more iterations.
+EXTENSIBLE = ("trial.iterations",)
+# What a checkpoint's identity leaves out of its trial's config: the settings a resume may
+# change, and the package version. The version says which code wrote config.json, not which
+# trial it is; in the identity it would orphan every checkpoint at each release (whether a
+# trial may be resumed by another version is for the config comparison on resume to say).
+_NOT_IDENTITY = (*EXTENSIBLE, "package_version")
+
+
+# The agent's random generator is seeded apart from the room's, from the same trial seed.
+AGENT_STREAM = 1
+
+
+class TrialError(Exception):
+    """A trial directory or setting that cannot be used; the message says why."""
+
+
+class TrialConfigError(TrialError, ValueError):
+    """A config.json no trial can be made from: a TrialError (one line, exit code 2) and a
+    ValueError, as the configs raise for it (callers catching either keep working)."""
+
+
+class TrialLocked(TrialError):
+    """Another process is writing into the trial directory."""
+
+
+def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
+    """One row of the iterations log: what was tried, in what context (10,), and what happened.
+    `stick_distance` is the handle's distance from the arm's base before the movement (m)."""
+    handle = context[list(context_indices("stick"))]
+    row = {
+        "iteration": iteration,
+        "motor_space": proposal.motor_space,
+        "model": -1 if proposal.model is None else int(proposal.model),
+        "stick_distance": float(np.hypot(*handle)),
+        "stick_grasped": False,
+        "stick_moved_by": "",
+        **{f"{toy}_moved_by": "" for toy in TOYS},
+        "word_recognised": "",
+        "caregiver_said": "",
+        "diverged": False,
+        "stick_returned": False,
+    }
+    for e in feedback.events:
+        if e.kind == ev.STICK_GRASPED:
+            row["stick_grasped"] = True
+        elif e.kind == ev.STICK_MOVED:
+            row["stick_moved_by"] = e.by
+        elif e.kind == ev.TOY_MOVED:
+            row[f"{e.obj}_moved_by"] = e.by
+        elif e.kind == ev.WORD_RECOGNISED:
+            row["word_recognised"] = e.word
+        elif e.kind == ev.CAREGIVER_SAID:
+            row["caregiver_said"] = e.word
+        elif e.kind == ev.DIVERGED:
+            row["diverged"] = True
+        elif e.kind == ev.STICK_RETURNED:
+            row["stick_returned"] = True
+    return row
+
+
+def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
+    """The agent and room of a trial's iteration 0, as its config makes them. TrialConfigError
+    (one line) for a config that makes none: a config.json edited by hand, or written before the
+    configs checked their settings."""
+    try:
+        settings = config["trial"]
+        room = Playroom(
+            grasp=settings["grasp"],
+            seed=settings["seed"],
+            config=config_from_dict(WorldConfig, config["world"]),
+            voice=config_from_dict(VoiceConfig, config["voice"]),
+        )
+        agent = Agent(
+            LearnerConfig.from_dict(config["learner"]),
+            np.random.default_rng([settings["seed"], AGENT_STREAM]),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
+    return agent, room
+
+
+def trial_identity(config: dict) -> dict:
+    """What a checkpoint carries of its trial (in its metadata): the seed, and a hash of the
+    trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
+    kept = json.loads(json.dumps(config))  # a deep copy
+    for key in _NOT_IDENTITY:
+        *parents, last = key.split(".")
+        node = kept
+        for parent in parents:
+            node = node.get(parent, {})
+        node.pop(last, None)
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    return {"seed": config["trial"]["seed"], "config": digest}
+
+
+def check_identity(path: Path, meta: dict, config: dict) -> None:
+    """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
+    A checkpoint without identity (written before checkpoints carried one) is taken as the
+    trial's: the caller says so where it can."""
+    found, own = meta.get("identity"), trial_identity(config)
+    if found is None or found == own:
+        return
+    seed, digest = (
+        (found.get("seed"), found.get("config")) if isinstance(found, dict) else 2 * ("?",)
+    )
+    raise TrialError(
+        f"{path.name} belongs to another trial (seed {seed}, config {digest}) than "
+        f"{path.parent} (seed {own['seed']}, config {own['config']}); refusing to mix them"
+    )
+
+
+def restore_checkpoint(
+    trial_dir: str | os.PathLike,
+    agent: Agent,
+    room: Playroom,
+    name: str = CHECKPOINT_FILE,
+    *,
+    config: dict,
+) -> dict:
+    """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
+    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored;
+    TrialError if it belongs to another trial than `config`'s."""
+    path = Path(trial_dir) / name
+    if not path.exists():
+        raise storage.CorruptFileError(f"{path} is missing")
+    arrays, meta = storage.read_arrays(path)
+    check_identity(path, meta, config)
+    try:
+        agent_state = {
+            k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")
+        }
+        agent.load_state_dict(agent_state)
+        room.set_state({**meta["room"], "physics": arrays["room/physics"]})
+        meta["best_word_distance"] = arrays["best_word_distance"].copy()
+    except (KeyError, ValueError, TypeError) as exc:
+        raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
+    return meta

@@ -1,0 +1,1 @@
+"""Videos of trials: rendering, overlay, sound, encoding, exact replay."""

@@ -1,0 +1,142 @@
+"""Videos of a trial's iterations, by replaying the trial from its start.
+
+A trial is deterministic given its config: the same agent and room, seeded the same way, make
+the same proposals and the same feedback. Replaying from iteration 0 to the chosen iterations
+(without filming the others) therefore reproduces them exactly; each filmed iteration's events
+are checked against the trial's log, and any difference is reported, not hidden.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+from tqdm import tqdm
+
+from experiments import storage
+from experiments.analysis.logs import read_log
+from experiments.file_names import CONFIG_FILE
+from experiments.run.trial_files import fresh_trial_parts, log_row
+from experiments.video.episodes import EpisodeRenderer, check_output_path, film_iteration
+from experiments.video.recording import parse_size
+from learner.agent import Proposal
+from models.layout import MODELS, TOYS
+from models.world import Feedback
+from sim.dmp import voice_trajectory
+from sim.vocal.audio import synthesise, synthesise_word
+
+
+class ReplayError(Exception):
+    """A trial or a choice of iterations that cannot be replayed; the message says why."""
+
+
+@dataclass
+class ReplayedIteration:
+    iteration: int
+    logged: dict
+    replayed: dict
+
+    @property
+    def matches(self) -> bool:
+        return self.logged == self.replayed
+
+
+def highlights(log: pd.DataFrame) -> dict[str, int]:
+    """The first iteration of each notable event in a trial's log: a hand grasp (a toy moved by
+    the hand), the first stick grasp, a toy caught by the stick, and a recognised word with the
+    caregiver bringing the toy."""
+    toy_by = {
+        by: pd.concat([log[f"{t}_moved_by"] == by for t in TOYS], axis=1).any(axis=1)
+        for by in ("hand", "stick", "caregiver")
+    }
+    wanted = {
+        "hand grasp": toy_by["hand"],
+        "first tool use": log["stick_grasped"],
+        "toy caught by the stick": toy_by["stick"],
+        "word brings a toy": toy_by["caregiver"] & (log["word_recognised"] != ""),
+    }
+    found = {}
+    for name, mask in wanted.items():
+        hits = log["iteration"][mask]
+        if len(hits):
+            found[name] = int(hits.iloc[0])
+    return found
+
+
+def _goal_block(model: int | None) -> str | None:
+    """The sensory block a model's goal lives in, for drawing it."""
+    return None if model is None else MODELS[model].sensory_block
+
+
+def render_trial(
+    trial_dir: str | os.PathLike,
+    out_path: str | os.PathLike,
+    iterations: Iterable[int] | None = None,
+    use_highlights: bool = False,
+    size: str | tuple[int, int] = "640x480",
+    fps: float = 50.0,
+    camera: str = "top",
+    progress: bool = True,
+) -> tuple[Path, list[ReplayedIteration]]:
+    """Film chosen iterations of a trial (or its highlights) into one MP4 with sound.
+
+    Returns the MP4's path and, per filmed iteration, its logged and replayed log rows.
+    """
+    trial_dir = Path(trial_dir)
+    if not (trial_dir / CONFIG_FILE).exists():
+        raise ReplayError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    out = check_output_path(out_path)
+    size = parse_size(size)
+    log = read_log(trial_dir)
+    if log.empty:
+        raise ReplayError(f"{trial_dir} has no logged iterations yet (no checkpoint)")
+    if use_highlights:
+        chosen = highlights(log)
+        if not chosen:
+            raise ReplayError(f"{trial_dir}: no highlight in {len(log)} iterations")
+        wanted = sorted(set(chosen.values()))
+    else:
+        wanted = sorted(set(int(i) for i in (iterations or [])))
+        if not wanted:
+            raise ReplayError("choose iterations (--iterations I,J,...) or --highlights")
+        bad = [i for i in wanted if not 0 <= i < len(log)]
+        if bad:
+            raise ReplayError(
+                f"iterations {bad} are out of range: the trial logged 0..{len(log) - 1}"
+            )
+    config = storage.read_json(trial_dir / CONFIG_FILE)
+    agent, room = fresh_trial_parts(config)
+    logged_rows = log.set_index("iteration")
+    results: list[ReplayedIteration] = []
+    bar = tqdm(total=wanted[-1] + 1, disable=not progress, desc="replay", unit="it")
+    with EpisodeRenderer(size, fps, camera) as renderer:
+        for it in range(wanted[-1] + 1):
+            if it in wanted:
+
+                def filmed(proposal: Proposal, it: int = it) -> Feedback:
+                    return film_iteration(
+                        renderer,
+                        room,
+                        proposal.motor_space,
+                        proposal.m,
+                        voice_audio=lambda m: synthesise(voice_trajectory(m)),
+                        word_audio=synthesise_word,
+                        model=None if proposal.model is None else f"{proposal.model + 1}",
+                        goal=proposal.goal,
+                        goal_block=_goal_block(proposal.model),
+                        iteration=it,
+                    )
+
+                proposal, context, feedback = agent.play(room, act=filmed)
+                logged = {"iteration": it, **logged_rows.loc[it].to_dict()}
+                replayed = log_row(it, proposal, feedback, context)
+                results.append(ReplayedIteration(it, logged, replayed))
+            else:
+                agent.play(room)
+            bar.update(1)
+        bar.close()
+        path = renderer.write(out)
+    return path, results
