@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 from importlib import resources
-from typing import Any
+from typing import Any, NoReturn
 
 
 def stored_profiles() -> list[str]:
@@ -63,5 +63,5 @@ def iteration_list(text: str) -> list[int]:
 class Parser(argparse.ArgumentParser):
     """argparse, with errors on one line (exit code 2) instead of usage plus message."""
 
-    def error(self, message: str) -> None:
+    def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message}\n")

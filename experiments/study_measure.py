@@ -39,6 +39,7 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -189,7 +190,7 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     pooled = pixel_sums(tests)
     competence, shares = numbers(pooled)
     disk = pixel_distance() < STRATEGY_BINS
-    summary = {
+    summary: dict[str, Any] = {
         # The notebook's renormalisation assumes nearly every pixel holds a test (100 runs):
         # with few, a bin's shares sum to less than 1.
         "coverage": float((pooled["count"][0][disk] > 0).mean()),
@@ -243,6 +244,7 @@ def _code_digest() -> str:
     data): a reference kept by another version of the project is not read back as this one's."""
     digest = hashlib.sha256(Path(__file__).read_bytes())
     for package in (sim, models):
+        assert package.__file__ is not None  # regular packages, not namespace ones
         folder = Path(package.__file__).parent
         files = (p for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
         for path in sorted(files):
