@@ -104,9 +104,13 @@ test-slow: $(INSTALLED)
 	$(PYTEST) -m slow
 	env $(OTHER_CPU) $(PYTEST)
 
+## lint: ruff's checks and format, mypy on the packages ([tool.mypy] in pyproject.toml;
+## its cache in .mypy_cache makes a second run a few seconds), then the import contracts of
+## the stages ([tool.importlinter])
 lint: $(INSTALLED)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	$(BIN)/mypy
 	$(BIN)/lint-imports
 
 format: $(INSTALLED)
@@ -122,4 +126,4 @@ voice-model: $(INSTALLED)
 	$(BIN)/python -m sim.vocal.fit_voice_model
 
 clean:
-	rm -rf $(VENV) .lock-venv .pytest_cache .ruff_cache
+	rm -rf $(VENV) .lock-venv .pytest_cache .ruff_cache .mypy_cache

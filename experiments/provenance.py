@@ -119,9 +119,10 @@ def simd_record() -> dict[str, list[str]]:
     """NumPy's SIMD, as `numpy.show_runtime` reports it: the baseline it was built for and the
     dispatched targets found on this CPU (and left on by NPY_DISABLE_CPU_FEATURES)."""
     try:
-        from numpy._core import _multiarray_umath as umath
+        # A private module, absent from NumPy's stubs.
+        from numpy._core import _multiarray_umath as umath  # type: ignore[attr-defined]
     except ImportError:  # NumPy 1.x kept it in numpy.core
-        from numpy.core import _multiarray_umath as umath  # type: ignore[no-redef]
+        from numpy.core import _multiarray_umath as umath
     found = umath.__cpu_features__
     return {
         "baseline": list(umath.__cpu_baseline__),
@@ -218,9 +219,9 @@ def bit_differences(a: dict, b: dict) -> list[str]:
     ea, eb = _part(a, "environment"), _part(b, "environment")
     for key in sorted(set(ea) | set(eb)):
         differ(key, ea.get(key, "unset"), eb.get(key, "unset"))
-    commits = [_part(r, "source").get("commit") for r in (a, b)]
-    if all(commits):
-        differ("commit", *(c[:10] for c in commits))
+    commit_a, commit_b = (_part(r, "source").get("commit") for r in (a, b))
+    if commit_a and commit_b:
+        differ("commit", commit_a[:10], commit_b[:10])
     return out
 
 

@@ -183,7 +183,8 @@ def write_arrays(path: Path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     buffer = io.BytesIO()
     payload = {k: np.asarray(v) for k, v in arrays.items()}
     payload["__meta__"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-    np.savez(buffer, **payload)
+    # mypy checks the ** values against savez's allow_pickle: bool too (none is named so).
+    np.savez(buffer, **payload)  # type: ignore[arg-type]
     write_bytes(path, buffer.getvalue())
 
 

@@ -158,13 +158,14 @@ class Agent:
             self._pending = None
             return
         if cfg.clip_sensory:
-            s = np.clip(s, -1.0, 1.0)
+            s = s.clip(-1.0, 1.0)  # np.clip's stubs would type s as any array-like again
         m = proposal.m
         changed = changed_blocks(context, s, cfg.change_tolerance, cfg.storing_rule)
         for k in self._by_space[proposal.motor_space]:
             if changed[self._block_of[k]]:
                 self.models[k].store(m, context, s)
         if proposal.model is not None:
+            assert proposal.goal is not None  # propose() gives every model's proposal a goal
             reached = s[self.models[proposal.model].sensory_slice]
             self.interest.update(proposal.model, proposal.goal, reached)
         if proposal.motor_space == "arm":

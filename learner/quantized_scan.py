@@ -16,6 +16,7 @@ every row whose b_i can belong to the exact nearest row, by the bound of `candid
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
@@ -47,7 +48,7 @@ def _compiled(function):
     cache) so that later processes load it in 0.2 s. Where no cache directory is writable (a
     read-only install without a home directory) numba refuses to cache: it is then compiled
     once per process instead, about 1 s."""
-    options = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
+    options: dict[str, Any] = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
     try:
         return numba.njit(cache=True, **options)(function)
     except RuntimeError:

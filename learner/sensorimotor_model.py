@@ -60,7 +60,10 @@ def _reference_indices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
             for axis in range(2):
                 s_dst += dims[axis].tolist()
                 s_src += [dims[axis, 0]] * N_SAMPLES
-    return tuple(np.array(a, dtype=np.intp) for a in (ctx_dst, ctx_src, s_dst, s_src))
+    ctx_dst_ix, ctx_src_ix, s_dst_ix, s_src_ix = (
+        np.array(a, dtype=np.intp) for a in (ctx_dst, ctx_src, s_dst, s_src)
+    )
+    return ctx_dst_ix, ctx_src_ix, s_dst_ix, s_src_ix
 
 
 _CTX_DST, _CTX_SRC, _S_DST, _S_SRC = _reference_indices()
@@ -80,7 +83,9 @@ def changed_blocks(
     reference = np.zeros(SENSORY_DIM)
     reference[_CTX_DST] = context[_CTX_SRC]
     reference[_S_DST] = s[_S_SRC]
-    return (np.abs(s - reference) > tolerance).reshape(len(SENSORY_BLOCKS), BLOCK_DIM).any(axis=1)
+    moved = (np.abs(s - reference) > tolerance).reshape(len(SENSORY_BLOCKS), BLOCK_DIM)
+    # NumPy's stubs type any(axis=1) as a bool or an array: they do not know moved is 2-D.
+    return moved.any(axis=1)  # type: ignore[return-value]
 
 
 class SensorimotorModel:
@@ -188,7 +193,7 @@ class SensorimotorModel:
         else:
             self.outcomes = 2 if (sensory != sensory[0]).any() else 1
 
-    def inverse(self, context: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, float]:
+    def inverse(self, context: np.ndarray, goal: ArrayLike) -> tuple[np.ndarray, float]:
         """(motor command (motor_dim,) of the stored (c_i, s_i) nearest to (c_i, goal), distance).
 
         context (10,) full context, goal (10,). Raises ValueError if the model is empty.
@@ -196,7 +201,7 @@ class SensorimotorModel:
         i, distance = self._nearest_inverse(context, goal)
         return self._motor[i].copy(), distance
 
-    def nearest_distance(self, context: np.ndarray, goal: np.ndarray) -> float:
+    def nearest_distance(self, context: np.ndarray, goal: ArrayLike) -> float:
         """Euclidean distance from (c_i, goal) to the nearest stored (c_i, s_i); inf if empty."""
         if self._n == 0:
             return float("inf")
@@ -241,7 +246,7 @@ class SensorimotorModel:
         forward = 0 if self._forward is None else self._forward.nbytes()
         return self._motor.nbytes + self._inverse.nbytes() + forward
 
-    def _nearest_inverse(self, context: np.ndarray, goal: np.ndarray) -> tuple[int, float]:
+    def _nearest_inverse(self, context: np.ndarray, goal: ArrayLike) -> tuple[int, float]:
         if self._n == 0:
             raise ValueError(f"model {self.spec.number} has no experience to invert")
         goal = np.asarray(goal, dtype=np.float64)

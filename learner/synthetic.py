@@ -55,7 +55,7 @@ class SyntheticWorld:
         handle = np.repeat(self._handle[None, :], 5, axis=0)
         if motor_space == "arm":
             hand = self.hand(m)
-            held = None
+            held: int | str | None = None  # a toy's index, or "stick"
             for k in range(5):
                 if held is None:
                     if np.linalg.norm(hand[k] - self._handle) < self.grasp_distance:
@@ -65,7 +65,7 @@ class SyntheticWorld:
                         held = int(np.argmax(near)) if near.any() else None
                 if held == "stick":
                     handle[k:] = hand[k:]
-                elif held is not None:
+                elif isinstance(held, int):
                     toys[held, k:] = hand[k:]
             word = held if isinstance(held, int) else int(self.rng.integers(3, 6))
             sound = self.words[word]
@@ -77,7 +77,7 @@ class SyntheticWorld:
                 toy = int(np.argmin(errors))
                 target = self._caregiver / 2.0
                 toys[toy] += 0.4 * SAMPLE_TIMES[:, None] * (target - self._toys[toy])
-        self._toys = toys[:, -1].copy()
+        self._toys: np.ndarray = toys[:, -1].copy()
         self._handle = handle[-1].copy()
         s = np.concatenate(
             [_block(hand), _block(handle)] + [_block(toys[i]) for i in range(3)] + [sound]

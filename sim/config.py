@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from models.checks import (
     check_choice,
@@ -115,7 +115,10 @@ def world_preset(preset: str, **overrides: Any) -> WorldConfig:
     )
 
 
-Config = TypeVar("Config")
+if TYPE_CHECKING:  # typeshed's protocol of dataclasses, for the type checker only
+    from _typeshed import DataclassInstance
+
+Config = TypeVar("Config", bound="DataclassInstance")
 
 
 def config_from_dict(cls: type[Config], values: dict[str, Any]) -> Config:

@@ -222,10 +222,12 @@ class Playroom:
         sound = np.zeros((N_STEPS, 2))
         held = None
         if movement == ARM:
+            assert joint_targets is not None  # act_arm passes them
             outcome = arm_movement(self.config, joint_targets, poses[0], poses[1:, :2])
             positions[1:], events, held = outcome.positions, outcome.events, outcome.hand_holds
             poses[0] = outcome.stick_pose
         else:
+            assert voice_formants is not None  # act_voice passes them
             events = self.caregiver.hear(p, voice_formants)
             positions[1:] = positions[0]
             if voice_grasp(self.config, positions[0, 0], poses[0]):  # the study's rule
@@ -256,7 +258,10 @@ class Playroom:
         sound = np.zeros((n, 2))
         positions[0] = p.tracked_positions()
         self.task.begin_movement(p, movement, voice_formants)
-        events = self.caregiver.hear(p, voice_formants) if movement == VOICE else []
+        events: list[ev.Event] = []
+        if movement == VOICE:
+            assert voice_formants is not None  # act_voice passes them
+            events = self.caregiver.hear(p, voice_formants)
         warnings = p.warning_counts()
         try:
             for k in range(n):

@@ -52,11 +52,11 @@ def _hand_path(waypoints: list[Waypoint], config: WorldConfig) -> tuple[np.ndarr
     steps = [0] + [w.step for w in waypoints]
     rest = hand_positions(np.zeros(3), config)
     points = np.vstack([rest] + [w.position for w in waypoints])
-    angles = [config.arm_rest_offset] + [
+    headings = [config.arm_rest_offset] + [
         w.angle if w.angle is not None else float(np.arctan2(w.position[1], w.position[0]))
         for w in waypoints
     ]
-    angles = np.unwrap(angles)
+    angles = np.unwrap(headings)
     t = np.arange(1, N_STEPS + 1)
     path = np.column_stack([np.interp(t, steps, points[:, i]) for i in range(2)])
     return path, np.interp(t, steps, angles)
@@ -91,4 +91,5 @@ def arm_command_through(
         )
         if best is None or error < best[1]:
             best = (command, error)
+    assert best is not None  # both elbows were tried
     return best

@@ -46,7 +46,7 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
     assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
     assert "experiments/batches/profiles/demo.json" in names
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
-    for tool in ("pytest", "pytest-xdist", "ruff"):
+    for tool in ("pytest", "pytest-xdist", "ruff", "mypy"):
         (line,) = [r for r in requires if re.split(r"[<>=!~; \[]", r.split()[1])[0] == tool]
         assert 'extra == "dev"' in line, line
 

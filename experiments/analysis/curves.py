@@ -73,9 +73,9 @@ def curve_rows(
             ("best_distance_names", [w for w in values.columns if w in names]),
             ("best_distance_distractors", [w for w in values.columns if w not in names]),
         ):
-            value = values[chosen].mean(axis=1)
+            means = values[chosen].mean(axis=1)
             parts.append(
-                pd.DataFrame({"iteration": words["iteration"], "metric": metric, "value": value})
+                pd.DataFrame({"iteration": words["iteration"], "metric": metric, "value": means})
             )
     return pd.concat(parts, ignore_index=True)
 

@@ -109,7 +109,9 @@ class BatchResults:
         }
         return dataclasses.replace(self, **tables, configs={**self.configs, **other.configs})
 
-    def _tables(self) -> dict[str, pd.DataFrame]:
+    # The table fields by name, typed Any: they go back to dataclasses.replace as keywords,
+    # which mypy checks against every field's type.
+    def _tables(self) -> dict[str, Any]:
         return {
             "trials": self.trials,
             "competence": self.competence,

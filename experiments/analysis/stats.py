@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 from scipy import stats
 
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults, Geometry
@@ -109,7 +110,7 @@ def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
 
 
 def mann_whitney(
-    a: np.ndarray, b: np.ndarray, alternative: str = "two-sided"
+    a: ArrayLike, b: ArrayLike, alternative: Literal["two-sided", "less", "greater"] = "two-sided"
 ) -> tuple[float, float]:
     """(U of a, p); NaN when a side is empty. Infinite values (a word never approached) rank
     above every finite one, which is what they mean. alternative "less": a tends lower."""

@@ -6,6 +6,7 @@ plays both). Pure computation on tables: no room is built here."""
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -68,7 +69,7 @@ def study_summary(tests: pd.DataFrame, reference: pd.DataFrame) -> dict:
     pooled = pixel_sums(tests)
     competence, shares = numbers(pooled)
     disk = pixel_distance() < STRATEGY_BINS
-    summary = {
+    summary: dict[str, Any] = {
         # The notebook's renormalisation assumes nearly every pixel holds a test (100 runs):
         # with few, a bin's shares sum to less than 1.
         "coverage": float((pooled["count"][0][disk] > 0).mean()),

@@ -11,6 +11,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from typing import TypeGuard
 
 from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
@@ -39,7 +40,7 @@ FIELD_RULES = {
 }
 
 
-def _is_int(value: object) -> bool:
+def _is_int(value: object) -> TypeGuard[int]:
     return isinstance(value, int) and not isinstance(value, bool)  # True is not a count
 
 
@@ -141,6 +142,7 @@ def load_spec(
         text = profiles.joinpath(f"{profile}.json").read_text()
         source = f"profile {profile}"
     else:
+        assert config_file is not None  # exactly one of the two was given
         path = Path(config_file)
         if not path.is_file():
             raise BatchError(f"batch config {path} does not exist")

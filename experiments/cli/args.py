@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import Any, NoReturn
 
 # What `playroom run` does when a setting is left out of a new trial (a resumed one keeps its
 # own: experiments/run/settings.py). TrialSettings' own defaults are those of short trials.
@@ -54,5 +54,5 @@ def iteration_list(text: str) -> list[int]:
 class Parser(argparse.ArgumentParser):
     """argparse, with errors on one line (exit code 2) instead of usage plus message."""
 
-    def error(self, message: str) -> None:
+    def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message}\n")

@@ -64,7 +64,9 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
             distance = float(np.linalg.norm(feedback.positions[-1, 1] - before))
             for source in touched or {"nothing"}:
                 pushes[source] += 1
-                moved[source] += distance / max(1, len(touched))
+                # typeshed counts a Counter in ints; these are metres (a source never pushed
+                # reads 0 all the same).
+                moved[source] += distance / max(1, len(touched))  # type: ignore[assignment]
     return {
         "pushes": {s: pushes[s] for s in SOURCES},
         "pushed_metres": {s: moved[s] for s in SOURCES},

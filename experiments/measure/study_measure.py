@@ -153,6 +153,7 @@ def _code_digest() -> str:
     data): a reference kept by another version of the project is not read back as this one's."""
     digest = hashlib.sha256(Path(__file__).read_bytes())
     for package in (sim, models):
+        assert package.__file__ is not None  # regular packages, not namespace ones
         folder = Path(package.__file__).parent
         files = (p for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
         for path in sorted(files):

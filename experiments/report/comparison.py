@@ -185,7 +185,8 @@ def _vocal_rows(a: BatchResults, b: BatchResults, threshold: float) -> list[list
     (Mann-Whitney U), on the words of every trial pooled."""
     below = [(s.vocal["best_distance"] < threshold).sum() for s in (a, b)]
     total = [len(s.vocal) for s in (a, b)]
-    fisher = stats.fisher_exact([[below[0], total[0] - below[0]], [below[1], total[1] - below[1]]])
+    table = np.array([[below[0], total[0] - below[0]], [below[1], total[1] - below[1]]])
+    fisher = stats.fisher_exact(table)
     rows = [
         [
             f"Words imitated within {threshold:g}",

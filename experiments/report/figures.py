@@ -97,6 +97,7 @@ def competence_map_figure(
         ax.set_yticks([-1, -0.5, 0, 0.5, 1])
         ax.set_xlabel("toy x")
         ax.set_ylabel("toy y")
+    assert mesh is not None, "no group to draw"
     bar = fig.colorbar(mesh, ax=axes, shrink=0.85, extend="min")
     bar.set_label("normalised competence (%)\n0 = random agent, 100 = perfect")
     fig.suptitle("Competence to bring a toy to the centre\nby toy position (paper Fig. 3)")

@@ -173,7 +173,7 @@ def where_table(results: BatchResults) -> tuple[Table, str]:
     # Recorded machines first, in the order trials were read; unknown ones last.
     groups = where.groupby(["status", *SHORT_FIELDS], sort=False)
     for values, here in sorted(groups, key=lambda g: g[0][0] != "recorded"):
-        status, *fields = values
+        status, *fields = map(str, values)  # text: the records' short fields
         if status != "recorded":
             fields = [unknown.get(status, status)] + [""] * (len(SHORT_FIELDS) - 1)
         counts = [_counts_text(here[here["role"] == role], results.groups) for role in ROLES]

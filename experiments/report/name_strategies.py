@@ -102,9 +102,9 @@ def _cells(shares: pd.DataFrame, rings: list[int], outer: int, said: str) -> lis
     """A row's cells after its label: toys, said share, vocal per ring, the outer ring's
     shares."""
     by_ring = shares.set_index("ring")
-    vocal = [pct(by_ring.loc[r, "vocal"]) if r in by_ring.index else "n/a" for r in rings]
+    vocal = [pct(by_ring["vocal"].loc[r]) if r in by_ring.index else "n/a" for r in rings]
     if outer in by_ring.index:
-        last = " / ".join(pct(by_ring.loc[outer, s]) for s in STRATEGIES)
+        last = " / ".join(pct(by_ring[s].loc[outer]) for s in STRATEGIES)
     else:
         last = "n/a"
     return [str(int(by_ring["toys"].max())), said, *vocal, last]

@@ -256,7 +256,7 @@ class Trial:
         return row
 
     def _word_row(self) -> dict:
-        row = {"iteration": self.iteration}
+        row: dict[str, float] = {"iteration": self.iteration}
         words = self.room.vocal_tract.config.words
         for word, best in zip(words, self.best_word_distance, strict=True):
             row[word] = float(best)
@@ -279,8 +279,9 @@ def run_trial(
     """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
     the run, with each line a resume has to report (a fallback checkpoint, an extension)."""
     trial = Trial(out_dir, settings, resume=resume)
-    for notice in trial.notices if notify is not None else ():
-        notify(notice)
+    if notify is not None:
+        for notice in trial.notices:
+            notify(notice)
     try:
         if trial.finished:
             return trial

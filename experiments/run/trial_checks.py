@@ -96,11 +96,11 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
     WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later
     are work past the checkpoint (a resume rewrites them) and are not looked at."""
     log = Path(trial_dir) / LOG_DIR
-    found = {"iterations": {}, "words": {}}
+    found: dict[str, dict[int, Path]] = {"iterations": {}, "words": {}}
     for path in log.glob("*.parquet"):
-        start = log_chunk_start(path)
-        if start is not None and start < iteration:
-            found[_CHUNK.fullmatch(path.name)["kind"]][start] = path
+        match = _CHUNK.fullmatch(path.name)
+        if match is not None and int(match["start"]) < iteration:
+            found[match["kind"]][int(match["start"])] = path
     start = 0
     while start < iteration:
         path = log / f"iterations-{start:08d}.parquet"

@@ -184,6 +184,7 @@ class EpisodeRenderer:
             views += [views[-1]] * self.hold_frames
         movement_start_s = (self.n_frames + self.lead_frames) / self.fps
         n_steps = N_STEPS
+        assert self._overlay is not None  # _recorder_for made it with the recorder
         for k, (frame, view) in enumerate(zip(frames, views, strict=True)):
             tick = k - self.lead_frames + 1  # control step of this frame
             image = self._overlay.draw(

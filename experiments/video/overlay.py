@@ -160,7 +160,8 @@ def object_colours(model: mujoco.MjModel) -> dict[str, tuple[int, int, int]]:
         geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, geom_name)
         mat = model.geom_matid[geom]
         rgba = model.mat_rgba[mat] if mat >= 0 else model.geom_rgba[geom]
-        colours[name] = tuple(int(round(255 * c)) for c in rgba[:3])
+        r, g, b = (int(round(255 * c)) for c in rgba[:3])
+        colours[name] = (r, g, b)
     return colours
 
 
@@ -255,6 +256,7 @@ class Overlay:
         pixels = pixels[np.isfinite(pixels).all(axis=1)]
         if len(pixels) == 0:
             return
+        assert caption.goal_block is not None  # drawn only when goal_is_position
         colour = (*self.colours.get(caption.goal_block, DEFAULT_EVENT_COLOUR), GOAL_ALPHA)
         width = max(1, self.height // 160)
         pen.line([tuple(p) for p in pixels], fill=colour, width=width, joint="curve")

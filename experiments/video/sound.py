@@ -76,5 +76,6 @@ def write_track(
     at `rate` Hz; returns the path. The clips were levelled one by one when mixed, so the
     track is written as it is: normalising it as a whole would change their balance."""
     track = mix_audio(clips, duration_s, rate)
-    write_wav(path, track, rate, peak=None)
-    return Path(path)
+    out = Path(path)
+    write_wav(out, track, rate, peak=None)
+    return out

@@ -42,7 +42,8 @@ class FormantMap:
         path.parent.mkdir(parents=True, exist_ok=True)
         arrays = {f"w{i}": w.astype(np.float32) for i, w in enumerate(self.weights)}
         arrays |= {f"b{i}": b.astype(np.float32) for i, b in enumerate(self.biases)}
-        np.savez(path, y_mean=self.y_mean, y_std=self.y_std, **arrays, **report)
+        # mypy checks the ** values against savez's allow_pickle: bool too (none is named so).
+        np.savez(path, y_mean=self.y_mean, y_std=self.y_std, **arrays, **report)  # type: ignore[arg-type]
 
     @classmethod
     def load(cls, path: Path = DATA_FILE) -> FormantMap:
