@@ -23,6 +23,10 @@ from experiments.cli_args import (
     stored_profiles,
 )
 from experiments.cli_faults import run_command
+from learner.config import BABBLING_MODES
+from models.presets import PRESETS
+from sim.config import STICK_RETURNS
+from sim.grasping.names import DEFAULT_GRASP, GRASPS
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -281,7 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("random", help="act random arm commands and print what happened")
-    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--grasp", choices=GRASPS, default=DEFAULT_GRASP)
     p.add_argument("--iterations", type=positive_int, default=20)
     p.add_argument("--seed", type=non_negative_int, default=0)
     p.set_defaults(func=cmd_random)
@@ -289,7 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="one trial of Model Babbling into a directory")
     # No argparse defaults: a setting left out is the default below for a new trial, and the
     # trial's own (config.json) with --resume, where a setting given must match it.
-    p.add_argument("--grasp", choices=["kinematic", "physical"], help=run_default("grasp"))
+    p.add_argument("--grasp", choices=GRASPS, help=run_default("grasp"))
     p.add_argument(
         "--iterations",
         type=positive_int,
@@ -297,19 +301,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=non_negative_int, help=run_default("seed"))
     p.add_argument("--out", required=True, help="the trial directory")
-    p.add_argument("--babbling", choices=["random", "active"], help=run_default("babbling"))
+    p.add_argument("--babbling", choices=BABBLING_MODES, help=run_default("babbling"))
     p.add_argument(
         "--checkpoint-every", type=positive_int, metavar="K", help=run_default("checkpoint_every")
     )
     p.add_argument(
         "--stick-return",
-        choices=["out_of_reach", "never"],
+        choices=STICK_RETURNS,
         help="the experimenter returns a stick beyond reach, or never (the study); "
         + run_default("stick_return"),
     )
     p.add_argument(
         "--preset",
-        choices=["study", "project"],
+        choices=PRESETS,
         help="world and learner as the study's code behaved, or the project's earlier choices "
         "(docs/protocol.md §11); " + run_default("preset"),
     )
@@ -361,7 +365,7 @@ def build_parser() -> argparse.ArgumentParser:
     which.add_argument("--iterations", type=iteration_list, help="I,J,...: iterations to film")
     which.add_argument("--highlights", action="store_true", help="first grasp, tool use, ...")
     p.add_argument("--random", action="store_true", help="random commands in a new room")
-    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--grasp", choices=GRASPS, default=DEFAULT_GRASP)
     p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--size", default="640x480", help="WxH, even numbers")
     p.add_argument("--fps", type=float, default=50.0)

@@ -6,6 +6,10 @@ import argparse
 from importlib import resources
 from typing import Any
 
+from models.presets import DEFAULT_PRESET
+from sim.config import DEFAULT_WORLD
+from sim.grasping.names import DEFAULT_GRASP
+
 
 def stored_profiles() -> list[str]:
     """The batch profiles shipped in experiments/profiles/, by name."""
@@ -17,13 +21,13 @@ def stored_profiles() -> list[str]:
 # What `playroom run` does when a setting is left out of a new trial (a resumed one keeps its
 # own: experiments/trial_settings.py). TrialSettings' own defaults are those of short trials.
 RUN_DEFAULTS: dict[str, Any] = {
-    "grasp": "kinematic",
+    "grasp": DEFAULT_GRASP,
     "iterations": 80000,
     "seed": 0,
     "babbling": "random",
     "checkpoint_every": 1000,
-    "stick_return": "out_of_reach",
-    "preset": "study",
+    "stick_return": DEFAULT_WORLD.stick_return,
+    "preset": DEFAULT_PRESET,
 }
 
 
