@@ -2,9 +2,9 @@
 after an arm movement, what she hears of the agent's voice, and how she brings a toy.
 
 The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
-which word names which toy is hers, drawn once per room. In the physical backend she carries a
-toy with her hand, a mocap body welded to the toy, lifted above the table; in the kinematic
-backend the toy is placed directly, as in the study.
+which word names which toy is hers, drawn once per room. How a toy she brings moves is the
+grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy, lifted
+above the table, in the physical backend; placed directly, as in the study, in the kinematic one.
 """
 
 from __future__ import annotations
