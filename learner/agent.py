@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from learner.config import LearnerConfig
+from learner.config import LearnerConfig, learner_preset
 from learner.interest import InterestModel
 from learner.sensorimotor_model import SensorimotorModel, changed_blocks
 from models.layout import (
@@ -42,6 +42,7 @@ from models.layout import (
     ModelSpec,
     block_slice,
 )
+from models.presets import DEFAULT_PRESET
 from models.world import Feedback, World
 
 _SPACE_CODE = {"arm": 0, "voice": 1}  # bootstrap order is stored as these codes
@@ -60,7 +61,8 @@ class Proposal:
 
 
 class Agent:
-    """Model Babbling over the models of `models` (default: the study's 10)."""
+    """Model Babbling over the models of `models` (default: the study's 10), with the learner
+    `config` (default: the default preset's, `learner_preset(DEFAULT_PRESET)`)."""
 
     def __init__(
         self,
@@ -68,7 +70,7 @@ class Agent:
         rng: np.random.Generator | int | None = None,
         models: tuple[ModelSpec, ...] = MODELS,
     ) -> None:
-        self.config = config if config is not None else LearnerConfig()
+        self.config = config if config is not None else learner_preset(DEFAULT_PRESET)
         self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
         self.specs = tuple(models)
         self.models = [SensorimotorModel(spec, self.config) for spec in self.specs]

@@ -16,6 +16,7 @@ from typing import Any
 
 from models import layout
 from models.checks import check_bool, check_choice, check_int, check_number
+from models.presets import PRESETS
 
 BABBLING_MODES = ("random", "active")
 IMITATION_DRAWS = ("distinct", "heard")
@@ -122,10 +123,6 @@ class LearnerConfig:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), sort_keys=True)
-
-
-DEFAULT_LEARNER = LearnerConfig()
-PRESETS = ("study", "project")
 
 
 def learner_preset(preset: str, **overrides: Any) -> LearnerConfig:

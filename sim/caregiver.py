@@ -2,29 +2,25 @@
 after an arm movement, what she hears of the agent's voice, and how she brings a toy.
 
 The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
-which word names which toy is hers, drawn once per room. In the physical backend she carries a
-toy with her hand, a mocap body welded to the toy, lifted above the table; in the kinematic
-backend the toy is placed directly, as in the study.
+which word names which toy is hers, drawn once per room. How a toy she brings moves is the
+grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy, lifted
+above the table, in the physical backend; placed directly, as in the study, in the kinematic one.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
 from sim.config import WorldConfig
-from sim.model_edits import ModelEdits
-from sim.physics import OBJECTS, PlayroomPhysics
+from sim.grasping.base import GraspBackend
+from sim.physics import PlayroomPhysics
 from sim.vocal.config import VoiceConfig
-from sim.vocal.tract import VocalTract
+from sim.vocal.voice import Voice
 from sim.vocal.words import word_features
-
-# The name under which she edits the model (sim/model_edits.py).
-OWNER = "caregiver"
 
 
 @dataclass(frozen=True)
@@ -52,16 +48,14 @@ class Caregiver:
 
     def __init__(
         self,
-        physical: bool,
+        backend: GraspBackend,
         config: WorldConfig,
-        vocal_tract: VocalTract,
-        edits: ModelEdits,
+        vocal_tract: Voice,
         rng: np.random.Generator,
     ) -> None:
-        self.physical = physical
+        self.backend = backend  # how she carries a toy
         self.config = config
         self.vocal_tract = vocal_tract
-        self.edits = edits
         self.words: WordAssignment = assign_words(rng, vocal_tract.config)
         self.bringing: int | None = None  # index of the toy she is bringing
 
@@ -105,41 +99,17 @@ class Caregiver:
     def start_bringing(self, physics: PlayroomPhysics, toy: int) -> None:
         """Take toy `toy` (0-based) and bring it over the coming control steps."""
         self.bringing = toy
-        if not self.physical:
-            return
-        m, d = physics.model.ptr, physics.data.ptr
-        hand = physics.caregiver_hand_mocap
-        d.mocap_pos[hand, :2] = physics.toy_positions()[toy]
-        mujoco.mj_kinematics(m, d)
-        # Her hand sits on the toy: the weld holds it there, upright.
-        self.edits.weld_here(OWNER, f"caregiver_{TOYS[toy]}", keep_orientation=False)
-        # She lifts the toy: while carried it touches nothing, as a toy carried above the
-        # table would not (dragged along the table it would sweep the stick out of reach).
-        self.edits.make_intangible(OWNER, physics.toy_geoms[toy])
-        self.edits.lift(OWNER, OBJECTS.index(TOYS[toy]))
+        self.backend.caregiver_takes(physics, toy)
 
     def before_step(self, physics: PlayroomPhysics) -> None:
         """Move the toy she is bringing `caregiver_bring_rate` of the remaining way."""
         if self.bringing is None:
             return
-        rate = self.config.caregiver_bring_rate
-        target = self.target(physics)
-        d = physics.data.ptr
-        if self.physical:
-            hand = physics.caregiver_hand_mocap
-            d.mocap_pos[hand, :2] += rate * (target - d.mocap_pos[hand, :2])
-        else:
-            poses = physics.object_poses()
-            poses[1 + self.bringing, :2] += rate * (target - poses[1 + self.bringing, :2])
-            physics.set_object_poses(poses)
+        self.backend.caregiver_carries(physics, self.bringing, self.target(physics))
 
     def stop(self, physics: PlayroomPhysics) -> None:
         """Put the toy down where it is."""
         if self.bringing is None:
             return
-        if self.physical:
-            self.edits.clear(OWNER)
-            d = physics.data.ptr
-            d.qvel[physics.object_dof] = 0.0
-            d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
+        self.backend.caregiver_puts_down(physics)
         self.bringing = None

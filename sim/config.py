@@ -21,11 +21,12 @@ from models.checks import (
     is_number,
     tuples,
 )
+from models.presets import PRESETS
 
 # The allowed values of the world's choices. sim/dmp.py and sim/experimenter.py, which apply
 # them, import them from here, so that a config is checked without importing either.
 DMP_KINDS = ("study", "project")  # sim/dmp.py
-CATCH_RULES = ("study", "held_stick")  # sim/grasp.py, sim/kinematic_movement.py
+CATCH_RULES = ("study", "held_stick")  # sim/grasping/kinematic.py
 STICK_RETURNS = ("never", "out_of_reach")  # sim/experimenter.py
 N_RINGS = 3  # the study's rings; evaluations and reports name them ring1..ring3
 
@@ -99,8 +100,9 @@ def _check_rings(name: str, rings: Any) -> None:
         )
 
 
+# The fields' defaults: the base every preset edits, equal to the "project" preset's world. A
+# room built without a config gets the default preset's (sim/playroom.py, models/presets.py).
 DEFAULT_WORLD = WorldConfig()
-PRESETS = ("study", "project")
 
 
 def world_preset(preset: str, **overrides: Any) -> WorldConfig:

@@ -17,20 +17,26 @@ import numpy as np
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
 from sim.config import WorldConfig
+from sim.grasping.base import GraspBackend
+from sim.kinematics import segment_distance
 from sim.physics import PlayroomPhysics
 
-# Toys placed in the physical backend keep this clearance from each other and the stick (m):
-# two solid objects cannot share a place, and overlapping geoms would be pushed apart violently.
+# Toys placed among solid objects (the physical backend) keep this clearance from each other and
+# the stick (m): two solid objects cannot share a place, and overlapping geoms would be pushed
+# apart violently.
 PLACEMENT_CLEARANCE = 0.01
 
 
 class Experimenter:
     """Places the toys of a room, and returns its stick when the config says so."""
 
-    def __init__(self, config: WorldConfig, physics: PlayroomPhysics, solid: bool) -> None:
+    def __init__(
+        self, config: WorldConfig, physics: PlayroomPhysics, backend: GraspBackend
+    ) -> None:
         self.config = config
         self.physics = physics
-        self.solid = solid  # physical objects: placements keep clear of each other
+        self.backend = backend
+        self.solid = backend.solid  # solid objects: placements keep clear of each other
         m = physics.model.ptr
         self.toy_radius = float(m.geom_size[physics.toy_geoms[0], 0])
         # The thickest part of the stick (its tip sphere), measured from the handle-tip line.
@@ -76,20 +82,9 @@ class Experimenter:
 
     # The stick ----------------------------------------------------------------------------
     def stick_lost(self) -> bool:
-        """Whether the backend's grasp rule can no longer reach the stick's handle: in the
-        kinematic backend the handle lies beyond the arm's length plus the grasp distance; in
-        the physical one no point of the handle geom lies within the arm's length plus the
-        radii of the hand sphere and of the handle (contact is impossible)."""
-        cfg, p = self.config, self.physics
-        if not self.solid:
-            return float(np.hypot(*p.stick_handle())) > cfg.arm_length + cfg.grasp_distance
-        m, d = p.model.ptr, p.data.ptr
-        handle = p.handle_geom
-        axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z
-        centre, half = d.geom_xpos[handle, :2], m.geom_size[handle, 1]
-        nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
-        contact = m.geom_size[p.hand_geom, 0] + m.geom_size[handle, 0]
-        return nearest > cfg.arm_length + contact
+        """Whether the backend's grasp rule can no longer reach the stick's handle (each
+        backend says when: sim/grasping/)."""
+        return self.backend.stick_out_of_reach(self.physics)
 
     def return_stick_if_lost(self) -> list[ev.Event]:
         """With stick_return 'out_of_reach': a lost stick back at its start pose, if no toy
@@ -107,10 +102,3 @@ class Experimenter:
         poses[0] = (*cfg.stick_start_handle, cfg.stick_start_angle)
         p.set_object_poses(poses)
         return [ev.Event(ev.STICK_RETURNED, N_STEPS, obj="stick", by="experimenter")]
-
-
-def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-    """Distance (m) from `point` to the segment [a, b]."""
-    ab = b - a
-    t = np.clip(np.dot(point - a, ab) / np.dot(ab, ab), 0.0, 1.0)
-    return float(np.linalg.norm(point - (a + t * ab)))

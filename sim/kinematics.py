@@ -1,5 +1,6 @@
-"""The arm's analytic forward kinematics (docs/protocol.md §1), used to check the MJCF model and to
-plan scripted commands without running the physics."""
+"""Plane geometry without the physics: the arm's analytic forward kinematics (docs/protocol.md §1),
+used to check the MJCF model, to run the kinematic rules and to plan scripted commands; and the
+distance from a point to a segment (the stick)."""
 
 from __future__ import annotations
 
@@ -20,3 +21,10 @@ def hand_positions(joint_angles: np.ndarray, config: WorldConfig = DEFAULT_WORLD
     x = (lengths * np.cos(absolute)).sum(axis=0)
     y = (lengths * np.sin(absolute)).sum(axis=0)
     return np.stack([x, y], axis=-1)
+
+
+def segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance (m) from `point` to the segment [a, b]."""
+    ab = b - a
+    t = np.clip(np.dot(point - a, ab) / np.dot(ab, ab), 0.0, 1.0)
+    return float(np.linalg.norm(point - (a + t * ab)))

@@ -1,6 +1,6 @@
 """The one owner of run-time edits of the playroom model: welds, collision bits, damping.
 
-Grasping (sim/grasp.py) and the caregiver (sim/caregiver.py) both change the compiled model
+Grasping and the caregiver's carrying (sim/grasping/physical.py) both change the compiled model
 while a movement runs: a weld holds what is grasped or carried, a held object stops colliding
 with what holds it, a lifted object loses the table's damping. Each asks through this class
 under its own name, and the model's arrays are always recomputed from the compiled values plus

@@ -11,7 +11,6 @@ from dm_control import mujoco as dm_mujoco
 from models import playroom_xml
 from models.layout import TOYS
 from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.kinematics import hand_positions
 
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
 OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw
@@ -186,32 +185,3 @@ class PlayroomPhysics(dm_mujoco.Physics):
         if d.ncon == 0:
             return np.empty((0, 2), dtype=int)
         return d.contact.geom[: d.ncon].copy()
-
-
-class KinematicPhysics(PlayroomPhysics):
-    """The study's kinematic world: a step only recomputes positions.
-
-    The grasp rules set joint and object positions directly (sim/grasp.py); no dynamics run.
-    The hand is where the study's analytic forward kinematics puts it (sim/kinematics.py): the
-    same numbers as the whole-movement rules of sim/kinematic_movement.py, to the last bit.
-    MuJoCo's own hand site agrees with it within 1e-15 m and is what renders.
-    """
-
-    def step(self, nstep: int = 1) -> None:
-        mujoco.mj_kinematics(self._mj_model, self._mj_data)
-
-    def advance(self, nstep: int) -> None:
-        self.step(nstep)
-
-    def hand_position(self) -> np.ndarray:
-        return hand_positions(self.arm_angles()[:, None], self.config)[0]
-
-    def tracked_positions(self) -> np.ndarray:
-        out = super().tracked_positions()
-        out[0] = self.hand_position()
-        return out
-
-    def stick_tip(self) -> np.ndarray:
-        """The tip of the stick from its pose, by the same arithmetic as the held stick's."""
-        x, y, yaw = self.object_poses()[0]
-        return np.array([x, y]) + self.config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])

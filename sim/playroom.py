@@ -20,19 +20,21 @@ from models.layout import (
     VOICE_DIM,
     block_slice,
 )
+from models.presets import DEFAULT_PRESET
 from models.world import Feedback
 from sim import events as ev
 from sim.caregiver import Caregiver, WordAssignment
-from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.config import WorldConfig, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
-from sim.grasp import BACKENDS, make_backend
-from sim.kinematic_movement import arm_movement, brought_path, voice_grasp
+from sim.grasping.base import ClosedForm
+from sim.grasping.names import DEFAULT_GRASP
+from sim.grasping.registry import backend_class
 from sim.model_edits import ModelEdits
-from sim.physics import CONTROL_SUBSTEPS, KinematicPhysics, PlayroomPhysics
+from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 from sim.task import ARM, VOICE, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.tract import VocalTract
+from sim.vocal.registry import DEFAULT_TRACT, make_tract
 
 # Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
 RANGE_TOLERANCE = 1e-9
@@ -41,42 +43,41 @@ RANGE_TOLERANCE = 1e-9
 class Playroom:
     """The playroom world the learner talks to, built on the dm_control task.
 
-    grasp: 'kinematic' (the study's distance rules) or 'physical' (MuJoCo contacts).
+    grasp: a backend of sim/grasping/: 'kinematic' (the study's distance rules, the default)
+    or 'physical' (MuJoCo contacts).
     seed: seeds every random choice of the world (placements, the caregiver's words).
-    config, voice: the world's and the voice's numbers; the MJCF model is checked against
-    `config` when it loads.
+    config, voice: the world's and the voice's numbers (config: the default preset's world,
+    `world_preset(DEFAULT_PRESET)`, when None); the MJCF model is checked against `config`
+    when it loads. The vocal tract is the default one (sim/vocal/registry.py).
     exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
     a frame) instead of the fitted formant map (microseconds); for audio checks.
     """
 
     def __init__(
         self,
-        grasp: str = "physical",
+        grasp: str = DEFAULT_GRASP,
         seed: int = 0,
-        config: WorldConfig = DEFAULT_WORLD,
+        config: WorldConfig | None = None,
         voice: VoiceConfig = DEFAULT_VOICE,
         exact_voice: bool = False,
     ) -> None:
-        if grasp not in BACKENDS:
-            raise ValueError(f"unknown grasp backend {grasp!r}: choose one of {sorted(BACKENDS)}")
+        backend = backend_class(grasp)  # ValueError naming the backends
         if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
             raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+        config = world_preset(DEFAULT_PRESET) if config is None else config
         self.grasp = grasp
         self.seed = int(seed)
         self.config = config
         self.rng = np.random.default_rng(self.seed)
-        self.vocal_tract = VocalTract(exact=exact_voice, config=voice, world=config)
-        physics_class = KinematicPhysics if grasp == "kinematic" else PlayroomPhysics
-        self.physics: PlayroomPhysics = physics_class.load(config)
-        edits = ModelEdits(self.physics)
-        self.caregiver = Caregiver(grasp == "physical", config, self.vocal_tract, edits, self.rng)
-        self.task = PlayroomTask(
-            make_backend(grasp, config, edits), self.caregiver, self.vocal_tract
-        )
+        self.vocal_tract = make_tract(DEFAULT_TRACT, exact_voice, voice, config)
+        self.physics: PlayroomPhysics = backend.physics_class.load(config)
+        self.backend = backend(config, ModelEdits(self.physics))
+        self.caregiver = Caregiver(self.backend, config, self.vocal_tract, self.rng)
+        self.task = PlayroomTask(self.backend, self.caregiver, self.vocal_tract)
         self.env = control.Environment(
             self.physics, self.task, n_sub_steps=CONTROL_SUBSTEPS, time_limit=float("inf")
         )
-        self.experimenter = Experimenter(config, self.physics, solid=grasp == "physical")
+        self.experimenter = Experimenter(config, self.physics, self.backend)
         self.env.reset()
         self.iteration = 0
         # Called after every control step with (step, observation): renderers and recorders
@@ -108,8 +109,9 @@ class Playroom:
         """
         m = _checked_command(m, ARM_DIM, "arm command")
         targets = arm_trajectory(m, self.config)  # (3, N_STEPS)
-        if self._closed_form:
-            return self._run_kinematic(ARM, joint_targets=targets)
+        closed = self._closed_form()
+        if closed is not None:
+            return self._run_closed_form(closed, ARM, joint_targets=targets)
         actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
         actions[:, :N_JOINTS] = targets.T
         return self._run(ARM, actions)
@@ -127,8 +129,9 @@ class Playroom:
         actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
         formants = self.vocal_tract.trajectory_formants(articulators)
-        if self._closed_form:
-            feedback = self._run_kinematic(VOICE, voice_formants=formants)
+        closed = self._closed_form()
+        if closed is not None:
+            feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
         else:
             feedback = self._run(VOICE, actions, formants)
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
@@ -201,20 +204,23 @@ class Playroom:
         self.caregiver.words = WordAssignment(tuple(names), tuple(distractors))
 
     # The movement -------------------------------------------------------------------------
-    @property
-    def _closed_form(self) -> bool:
-        """The kinematic rules run a whole movement at once unless someone watches each step
-        (a video): the step-by-step path through the dm_control task gives the same result."""
-        return self.grasp == "kinematic" and not self.step_observers
+    def _closed_form(self) -> ClosedForm | None:
+        """The backend, if its rules run a whole movement at once (the kinematic one) and no
+        one watches each step (a video): the step-by-step path through the dm_control task
+        gives the same result."""
+        if isinstance(self.backend, ClosedForm) and not self.step_observers:
+            return self.backend
+        return None
 
-    def _run_kinematic(
+    def _run_closed_form(
         self,
+        closed: ClosedForm,
         movement: str,
         joint_targets: np.ndarray | None = None,
         voice_formants: np.ndarray | None = None,
     ) -> Feedback:
-        """One movement of the kinematic backend in closed form (sim/kinematic_movement.py);
-        the MuJoCo state is set once, at the end."""
+        """One movement in the backend's closed form (sim/grasping/kinematic.py); the MuJoCo
+        state is set once, at the end."""
         p = self.physics
         positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
         positions[0] = p.tracked_positions()
@@ -223,22 +229,21 @@ class Playroom:
         held = None
         if movement == ARM:
             assert joint_targets is not None  # act_arm passes them
-            outcome = arm_movement(self.config, joint_targets, poses[0], poses[1:, :2])
+            outcome = closed.arm_movement(joint_targets, poses[0], poses[1:, :2])
             positions[1:], events, held = outcome.positions, outcome.events, outcome.hand_holds
             poses[0] = outcome.stick_pose
         else:
             assert voice_formants is not None  # act_voice passes them
             events = self.caregiver.hear(p, voice_formants)
             positions[1:] = positions[0]
-            if voice_grasp(self.config, positions[0, 0], poses[0]):  # the study's rule
+            if closed.voice_grasp(positions[0, 0], poses[0]):  # the study's rule
                 events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
                 positions[1:, 1] = positions[0, 0]
                 poses[0] = (*positions[0, 0], self.config.arm_rest_offset)
             sound[:] = self.task.normalised(voice_formants)
             toy = self.caregiver.bringing
             if toy is not None:
-                rate = self.config.caregiver_bring_rate
-                path = brought_path(rate, positions[0, 2 + toy], self.caregiver.target(p))
+                path = closed.brought_path(positions[0, 2 + toy], self.caregiver.target(p))
                 positions[1:, 2 + toy] = path
         poses[1:, :2] = positions[-1, 2:]
         brought = self.caregiver.bringing

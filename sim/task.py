@@ -17,8 +17,9 @@ from dm_env import specs
 from models.layout import N_ARTICULATORS, N_JOINTS
 from sim import events as ev
 from sim.caregiver import Caregiver
-from sim.grasp import GraspBackend
+from sim.grasping.base import GraspBackend
 from sim.physics import PlayroomPhysics
+from sim.vocal.voice import Voice
 
 ARM = "arm"
 VOICE = "voice"
@@ -27,13 +28,13 @@ VOICE = "voice"
 class PlayroomTask(control.Task):
     """Drives the arm through a grasp backend, the caregiver, and the vocal-tract sensor.
 
-    `vocal_tract` is the voice (sim.vocal.VocalTract): its `formants(articulators)` gives log2
+    `vocal_tract` is the voice (sim.vocal.voice.Voice): its `formants(articulators)` gives log2
     (F1, F2) of the current articulators. The `sound` observation is those formants normalised
     as in docs/protocol.md §4 (log2 F1 - 8.5, log2 F2 - 10.25) while the agent speaks, the
     caregiver's word once she speaks, and zeros in silence.
     """
 
-    def __init__(self, grasp: GraspBackend, caregiver: Caregiver, vocal_tract=None) -> None:
+    def __init__(self, grasp: GraspBackend, caregiver: Caregiver, vocal_tract: Voice) -> None:
         super().__init__()
         self.grasp = grasp
         self.caregiver = caregiver

@@ -21,6 +21,11 @@ from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.trial_checks import load_trial
 from models.layout import ARM_DIM
 from sim import Playroom
+from sim.config import world_preset
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 
 class RestingAgent:
@@ -53,7 +58,7 @@ def test_strategy_classification():
 
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_scripted_agent_errors_match_a_hand_computation(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     table = competence_table(RestingAgent(), room, EvaluationSettings(n_placements=4, seed=9))
     assert len(table) == 3 * 4 * 3
     assert set(table["strategy"]) == {"hand"}
@@ -69,10 +74,10 @@ def test_scripted_agent_errors_match_a_hand_computation(grasp):
 
 
 def test_random_reference_is_seeded_and_normalisation_is_0_to_1():
-    room = Playroom("kinematic", seed=0)
+    room = Playroom("kinematic", seed=0, config=PROJECT)
     settings = EvaluationSettings(n_placements=3, seed=4)
     a = competence_table(RestingAgent(), room, settings)
-    b = competence_table(RestingAgent(), Playroom("kinematic", seed=0), settings)
+    b = competence_table(RestingAgent(), Playroom("kinematic", seed=0, config=PROJECT), settings)
     pd.testing.assert_frame_equal(a, b)
     # The reference is a random agent's own error: random commands that reach a toy score
     # otherwise than the resting agent, and another seed draws other commands.

@@ -1,7 +1,7 @@
 """The fast paths of a movement give what the step-by-step dm_control path gives.
 
 A room without step observers runs the kinematic rules over a whole movement at once
-(sim/kinematic_movement.py) and steps the physical backend without building observations; a
+(sim/grasping/kinematic.py) and steps the physical backend without building observations; a
 room with an observer (a video) goes through the dm_control environment step by step. Both
 must give the same feedback, sample by sample, and the same events, event by event.
 """

@@ -15,6 +15,11 @@ from experiments.measure.study_measure import (
     study_tests,
 )
 from experiments.run.trial_checks import load_trial
+from sim.config import world_preset
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 
 def test_the_map_normalises_each_pixel_by_the_random_error_around_its_distance():
@@ -83,7 +88,9 @@ def test_placements_are_drawn_from_each_trials_seed():
     settings = StudyMeasureSettings(n_placements=2)
 
     def positions(seed: int) -> np.ndarray:
-        tests = study_tests(Agent(LearnerConfig(), 0), Playroom("kinematic", seed=seed), settings)
+        tests = study_tests(
+            Agent(LearnerConfig(), 0), Playroom("kinematic", seed=seed, config=PROJECT), settings
+        )
         return tests[["x", "y"]].to_numpy()
 
     assert np.array_equal(positions(1), positions(1))

@@ -20,8 +20,13 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from models.layout import SAMPLE_INDICES
 from sim import Playroom
+from sim.config import world_preset
 from sim.dmp import arm_trajectory
 from sim.kinematics import hand_positions
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
 REPO = Path(__file__).parent.parent
@@ -104,7 +109,7 @@ def test_a_3000_iteration_run_learns_to_reach_hand_goals(trained_trial):
     trial = trained_trial
     agent = trial.agent
     rng = np.random.default_rng(123)
-    room = Playroom("kinematic", seed=77)
+    room = Playroom("kinematic", seed=77, config=PROJECT)
     learned, random_errors = [], []
     for _ in range(60):
         # A reachable goal: the hand trajectory of another random command, at the 5 samples.

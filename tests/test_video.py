@@ -16,8 +16,13 @@ from experiments.video import encoding, episodes, recording, sound
 from experiments.video.overlay import CameraView
 from models.layout import N_STEPS, VOICE_DIM
 from sim import Playroom
+from sim.config import world_preset
 from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.audio import write_wav
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 SIZE = (160, 120)
 FPS = 50.0
@@ -71,7 +76,7 @@ def reach_command() -> np.ndarray:
 
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_short_render_has_frames_sound_and_motion(grasp, reach_command, tmp_path):
-    room = Playroom(grasp=grasp, seed=0)
+    room = Playroom(grasp=grasp, seed=0, config=PROJECT)
     out = tmp_path / "short.mp4"
     per_iteration = LEAD + STEPS + HOLD
     with episodes.EpisodeRenderer(SIZE, FPS, lead_frames=LEAD, hold_frames=HOLD) as renderer:
@@ -129,7 +134,7 @@ def test_render_random_writes_mp4_with_sound(tmp_path):
 
 @pytest.mark.parametrize("camera", ["top", "hand_view"])
 def test_projection_lands_on_bodies(camera):
-    room = Playroom(grasp="kinematic", seed=0)
+    room = Playroom(grasp="kinematic", seed=0, config=PROJECT)
     # Asymmetric places, so that a flipped axis would miss.
     room.arrange(toys=np.array([[0.45, -0.3], [-0.6, 0.25], [0.15, 0.7]]))
     model, data = room.physics.model.ptr, room.physics.data.ptr
@@ -221,13 +226,13 @@ def test_missing_gl_names_mujoco_gl_and_its_choices(monkeypatch):
         raise RuntimeError("eglInitialize failed")
 
     monkeypatch.setattr(recording.mujoco, "Renderer", no_gl)
-    room = Playroom(grasp="kinematic", seed=0)
+    room = Playroom(grasp="kinematic", seed=0, config=PROJECT)
     with pytest.raises(episodes.RenderError, match="MUJOCO_GL to one of egl, osmesa, glfw"):
         recording.FrameRecorder(room, SIZE)
 
 
 def test_refused_command_adds_no_frames():
-    room = Playroom(grasp="kinematic", seed=0)
+    room = Playroom(grasp="kinematic", seed=0, config=PROJECT)
     with episodes.EpisodeRenderer(SIZE, lead_frames=LEAD, hold_frames=HOLD) as renderer:
         with pytest.raises(ValueError):
             renderer.render_iteration(room, "arm", np.full(21, 2.0))
@@ -236,7 +241,7 @@ def test_refused_command_adds_no_frames():
 
 
 def test_rendering_after_write_is_refused(reach_command, tmp_path):
-    room = Playroom(grasp="kinematic", seed=0)
+    room = Playroom(grasp="kinematic", seed=0, config=PROJECT)
     with episodes.EpisodeRenderer(SIZE, lead_frames=0, hold_frames=0) as renderer:
         renderer.render_iteration(room, "arm", reach_command)
         renderer.write(tmp_path / "once.mp4")

@@ -10,16 +10,21 @@ from experiments.cli.main import main
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
+from sim.config import world_preset
 from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.produce import say
 from sim.vocal.words import word_distances, word_features
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 BACKENDS = ["kinematic", "physical"]
 
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_sound_block_is_the_agents_own_sound_after_a_vocal_movement(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     m = np.random.default_rng(0).uniform(-1, 1, VOICE_DIM)
     feedback = room.act_voice(m)
     np.testing.assert_allclose(feedback.s[50:], room.vocal_tract.sound_features(m), atol=1e-12)
@@ -29,7 +34,7 @@ def test_sound_block_is_the_agents_own_sound_after_a_vocal_movement(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_saying_a_toys_name_makes_the_caregiver_bring_it(grasp):
-    room = Playroom(grasp, seed=1)
+    room = Playroom(grasp, seed=1, config=PROJECT)
     toy = 2  # toy3, parked far away in ring 3
     room.arrange(toys=[[-0.5, -0.9], [0.9, -0.3], [0.7, 0.7]], caregiver=(0.9, 0.9))
     name = room.words.names[toy]
@@ -46,7 +51,7 @@ def test_saying_a_toys_name_makes_the_caregiver_bring_it(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_a_distractor_is_recognised_but_brings_nothing(grasp):
-    room = Playroom(grasp, seed=1)
+    room = Playroom(grasp, seed=1, config=PROJECT)
     word = room.words.distractors[0]
     before = room.context()[:8]
     feedback = room.act_voice(say(word))
@@ -56,7 +61,7 @@ def test_a_distractor_is_recognised_but_brings_nothing(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_caregiver_names_the_toy_in_the_hand_else_a_distractor(grasp):
-    room = Playroom(grasp, seed=2)
+    room = Playroom(grasp, seed=2, config=PROJECT)
     toy = np.array([0.2, 0.25])
     room.arrange(toys=[toy, [-0.15, -0.9], [-0.8, 0.5]])
     m, _ = arm_command_through([Waypoint(25, tuple(toy)), Waypoint(50, (0.3, 0.1))])
@@ -71,14 +76,14 @@ def test_caregiver_names_the_toy_in_the_hand_else_a_distractor(grasp):
 
 
 def test_words_are_shuffled_per_seed_into_names_and_distractors():
-    assignments = {Playroom("kinematic", seed=s).words for s in range(6)}
+    assignments = {Playroom("kinematic", seed=s, config=PROJECT).words for s in range(6)}
     assert len(assignments) > 1
     for words in assignments:
         assert len(set(words.names) | set(words.distractors)) == 6
 
 
 def test_exact_voice_option_gives_the_same_words():
-    exact = Playroom("kinematic", seed=0, exact_voice=True)
+    exact = Playroom("kinematic", seed=0, exact_voice=True, config=PROJECT)
     word = exact.words.names[0]
     feedback = exact.act_voice(say(word))
     assert word_distances(feedback.s[50:])[list(exact.vocal_tract.config.words).index(word)] < 0.4
@@ -86,7 +91,7 @@ def test_exact_voice_option_gives_the_same_words():
 
 
 def test_bad_voice_command_leaves_the_room_unchanged():
-    room = Playroom("physical", seed=0)
+    room = Playroom("physical", seed=0, config=PROJECT)
     before = room.get_state()
     for bad in (np.zeros(27), np.full(28, np.nan), np.full(28, 2.0)):
         with pytest.raises(ValueError, match="voice command"):

@@ -10,11 +10,15 @@ from dm_control.rl import control
 from models.layout import ARM_BASIS_FUNCTIONS, ARM_DIM, N_STEPS, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
-from sim.config import DEFAULT_WORLD
+from sim.config import DEFAULT_WORLD, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.kinematics import hand_positions
 from sim.physics import PlayroomPhysics
 from sim.scripted import Waypoint, arm_command_through
+
+# The world these tests were written for: the project preset (explicit, as Playroom() takes
+# the default preset, the study's).
+PROJECT = world_preset("project")
 
 BACKENDS = ["kinematic", "physical"]
 # Toys parked in ring 3, away from every scripted path below.
@@ -33,7 +37,7 @@ def test_model_forward_kinematics_match_the_protocol():
 
 
 def test_rest_pose_points_along_y_and_stick_starts_at_its_place():
-    room = Playroom("kinematic", seed=0)
+    room = Playroom("kinematic", seed=0, config=PROJECT)
     np.testing.assert_allclose(room.physics.hand_position(), [0.0, 0.5], atol=1e-9)
     np.testing.assert_allclose(room.context()[:2], DEFAULT_WORLD.stick_start_handle, atol=1e-9)
     np.testing.assert_allclose(room.physics.stick_tip(), [-0.25, 0.25], atol=1e-9)
@@ -69,7 +73,7 @@ def test_dmp_output_is_bounded_deterministic_and_shaped():
 
 # The dm_control task ------------------------------------------------------------------------
 def test_room_is_built_on_a_dm_control_environment():
-    room = Playroom("physical", seed=0)
+    room = Playroom("physical", seed=0, config=PROJECT)
     assert isinstance(room.task, control.Task)
     assert isinstance(room.env, control.Environment)
     assert room.env.action_spec().shape == (10,)
@@ -91,7 +95,7 @@ def _moved(feedback, name: str) -> bool:
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_hand_on_handle_then_sweep_moves_the_stick(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     room.arrange(toys=PARKED_TOYS)
     hx, hy = room.context()[:2]
     # Come down beside the handle (not across the shaft), touch it, then sweep right.
@@ -110,7 +114,7 @@ def test_hand_on_handle_then_sweep_moves_the_stick(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_holding_the_stick_its_tip_moves_a_toy_in_ring_two(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     handle = np.array([0.15, 0.1])
     toy = np.array([0.6, 0.11])
     assert 0.5 < np.linalg.norm(toy) < 0.75, "the toy must lie beyond the hand's reach"
@@ -134,7 +138,7 @@ def test_holding_the_stick_its_tip_moves_a_toy_in_ring_two(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_hand_touching_a_toy_in_ring_one_moves_it(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     toy = np.array([0.2, 0.25])
     room.arrange(toys=np.vstack([toy, PARKED_TOYS[1:]]))
     m = _command([Waypoint(25, tuple(toy)), Waypoint(50, (0.35, 0.0))])
@@ -146,7 +150,7 @@ def test_hand_touching_a_toy_in_ring_one_moves_it(grasp):
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_command_far_from_everything_moves_nothing(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     room.arrange(toys=PARKED_TOYS)
     before = room.context()
     m = _command([Waypoint(20, (0.2, 0.4)), Waypoint(40, (0.32, 0.2)), Waypoint(50, (0.25, 0.3))])
@@ -162,7 +166,7 @@ def test_command_far_from_everything_moves_nothing(grasp):
 
 # Placements, caregiver, determinism ---------------------------------------------------------
 def test_toys_are_replaced_every_20_iterations_in_the_rings_and_caregiver_every_iteration():
-    room = Playroom("kinematic", seed=3)
+    room = Playroom("kinematic", seed=3, config=PROJECT)
     contexts = [room.context()]
     for _ in range(40):
         room.act_arm(np.zeros(ARM_DIM))
@@ -180,7 +184,7 @@ def test_toys_are_replaced_every_20_iterations_in_the_rings_and_caregiver_every_
 
 @pytest.mark.parametrize("grasp", BACKENDS)
 def test_caregiver_brings_a_toy_toward_the_midpoint(grasp):
-    room = Playroom(grasp, seed=0)
+    room = Playroom(grasp, seed=0, config=PROJECT)
     room.arrange(toys=PARKED_TOYS, caregiver=(-0.8, 0.6))
     start = room.context()[2:4].copy()
     target = np.array([-0.4, 0.3])
@@ -197,7 +201,7 @@ def test_same_seed_same_contexts_and_feedbacks(grasp):
     commands = rng.uniform(-1, 1, (15, ARM_DIM))
     runs = []
     for _ in range(2):
-        room = Playroom(grasp, seed=11)
+        room = Playroom(grasp, seed=11, config=PROJECT)
         runs.append([(room.context(), room.act_arm(m).s) for m in commands])
     for (c1, s1), (c2, s2) in zip(*runs, strict=True):
         np.testing.assert_array_equal(c1, c2)
@@ -206,13 +210,13 @@ def test_same_seed_same_contexts_and_feedbacks(grasp):
 
 def test_state_round_trip_continues_identically():
     rng = np.random.default_rng(2)
-    room = Playroom("physical", seed=5)
+    room = Playroom("physical", seed=5, config=PROJECT)
     for m in rng.uniform(-1, 1, (5, ARM_DIM)):
         room.act_arm(m)
     state = room.get_state()
     commands = rng.uniform(-1, 1, (5, ARM_DIM))
     first = [room.act_arm(m).s for m in commands]
-    other = Playroom("physical", seed=99)
+    other = Playroom("physical", seed=99, config=PROJECT)
     other.set_state(state)
     second = [other.act_arm(m).s for m in commands]
     np.testing.assert_array_equal(np.array(first), np.array(second))
@@ -231,7 +235,7 @@ def test_state_round_trip_continues_identically():
     ],
 )
 def test_bad_arm_commands_raise_and_leave_the_room_unchanged(command, message):
-    room = Playroom("physical", seed=0)
+    room = Playroom("physical", seed=0, config=PROJECT)
     before, state = room.context(), room.get_state()
     with pytest.raises(ValueError, match=message):
         room.act_arm(command)
@@ -241,7 +245,7 @@ def test_bad_arm_commands_raise_and_leave_the_room_unchanged(command, message):
 
 
 def test_bad_voice_command_and_options_raise():
-    room = Playroom("kinematic", seed=0)
+    room = Playroom("kinematic", seed=0, config=PROJECT)
     with pytest.raises(ValueError, match="voice command"):
         room.act_voice(np.zeros(21))
     with pytest.raises(ValueError, match="unknown grasp"):
@@ -253,7 +257,7 @@ def test_bad_voice_command_and_options_raise():
 
 
 def test_diverging_physics_is_reported_and_undone():
-    room = Playroom("physical", seed=0)
+    room = Playroom("physical", seed=0, config=PROJECT)
     before = room.context()
     # A timestep far too long for the stiff servos makes the simulation blow up.
     room.physics.model.ptr.opt.timestep = 5.0

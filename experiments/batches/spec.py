@@ -17,14 +17,15 @@ from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES
-from sim.config import PRESETS, STICK_RETURNS
+from models.presets import DEFAULT_PRESET, PRESETS
+from sim.config import STICK_RETURNS
+from sim.grasping.names import GRASPS
 
 
 class BatchError(Exception):
     """A batch that cannot run as asked; the message says why."""
 
 
-GRASPS = ("kinematic", "physical")
 # Fields of a batch config and of `BatchSpec`, with what each may hold (for the messages).
 FIELD_RULES = {
     "grasps": f"a non-empty list of distinct values from {', '.join(GRASPS)}",
@@ -62,7 +63,7 @@ class BatchSpec:
     checkpoint_every: int = 1000
     eval_placements: int = 100
     stick_return: str = "out_of_reach"
-    preset: str = "study"
+    preset: str = DEFAULT_PRESET
     overrides: dict = field(default_factory=dict)
     description: str = field(default="", compare=False)
 

@@ -5,16 +5,20 @@ from __future__ import annotations
 import argparse
 from typing import Any, NoReturn
 
+from models.presets import DEFAULT_PRESET
+from sim.config import DEFAULT_WORLD
+from sim.grasping.names import DEFAULT_GRASP
+
 # What `playroom run` does when a setting is left out of a new trial (a resumed one keeps its
 # own: experiments/run/settings.py). TrialSettings' own defaults are those of short trials.
 RUN_DEFAULTS: dict[str, Any] = {
-    "grasp": "kinematic",
+    "grasp": DEFAULT_GRASP,
     "iterations": 80000,
     "seed": 0,
     "babbling": "random",
     "checkpoint_every": 1000,
-    "stick_return": "out_of_reach",
-    "preset": "study",
+    "stick_return": DEFAULT_WORLD.stick_return,
+    "preset": DEFAULT_PRESET,
 }
 
 

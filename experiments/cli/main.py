@@ -23,6 +23,10 @@ from experiments.cli.args import (
     run_default,
 )
 from experiments.cli.faults import run_command
+from learner.config import BABBLING_MODES
+from models.presets import PRESETS
+from sim.config import STICK_RETURNS
+from sim.grasping.names import DEFAULT_GRASP, GRASPS
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -145,7 +149,8 @@ def cmd_render(args: argparse.Namespace) -> None:
     from experiments.video.episodes import render_random
     from experiments.video.replay import ReplayError, render_trial
     from sim.dmp import voice_trajectory
-    from sim.vocal.audio import synthesise, synthesise_word
+    from sim.vocal.audio import synthesise
+    from sim.vocal.produce import synthesise_word
 
     try:
         if args.random:
@@ -223,9 +228,9 @@ def cmd_say(args: argparse.Namespace) -> None:
     """A word as audio, from the voice parameters found to produce it."""
     from pathlib import Path
 
-    from sim.vocal.audio import synthesise_word, write_wav
+    from sim.vocal.audio import write_wav
     from sim.vocal.config import DEFAULT_VOICE
-    from sim.vocal.produce import stored_distances
+    from sim.vocal.produce import stored_distances, synthesise_word
 
     if args.word not in DEFAULT_VOICE.words:
         raise UsageError(f"unknown word {args.word!r}: one of {', '.join(DEFAULT_VOICE.words)}")
@@ -291,7 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("random", help="act random arm commands and print what happened")
-    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--grasp", choices=GRASPS, default=DEFAULT_GRASP)
     p.add_argument("--iterations", type=positive_int, default=20)
     p.add_argument("--seed", type=non_negative_int, default=0)
     p.set_defaults(func=cmd_random)
@@ -299,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="one trial of Model Babbling into a directory")
     # No argparse defaults: a setting left out is the default below for a new trial, and the
     # trial's own (config.json) with --resume, where a setting given must match it.
-    p.add_argument("--grasp", choices=["kinematic", "physical"], help=run_default("grasp"))
+    p.add_argument("--grasp", choices=GRASPS, help=run_default("grasp"))
     p.add_argument(
         "--iterations",
         type=positive_int,
@@ -307,19 +312,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=non_negative_int, help=run_default("seed"))
     p.add_argument("--out", required=True, help="the trial directory")
-    p.add_argument("--babbling", choices=["random", "active"], help=run_default("babbling"))
+    p.add_argument("--babbling", choices=BABBLING_MODES, help=run_default("babbling"))
     p.add_argument(
         "--checkpoint-every", type=positive_int, metavar="K", help=run_default("checkpoint_every")
     )
     p.add_argument(
         "--stick-return",
-        choices=["out_of_reach", "never"],
+        choices=STICK_RETURNS,
         help="the experimenter returns a stick beyond reach, or never (the study); "
         + run_default("stick_return"),
     )
     p.add_argument(
         "--preset",
-        choices=["study", "project"],
+        choices=PRESETS,
         help="world and learner as the study's code behaved, or the project's earlier choices "
         "(docs/protocol.md §11); " + run_default("preset"),
     )
@@ -371,7 +376,7 @@ def build_parser() -> argparse.ArgumentParser:
     which.add_argument("--iterations", type=iteration_list, help="I,J,...: iterations to film")
     which.add_argument("--highlights", action="store_true", help="first grasp, tool use, ...")
     p.add_argument("--random", action="store_true", help="random commands in a new room")
-    p.add_argument("--grasp", choices=["kinematic", "physical"], default="physical")
+    p.add_argument("--grasp", choices=GRASPS, default=DEFAULT_GRASP)
     p.add_argument("--seed", type=non_negative_int, default=0)
     p.add_argument("--size", default="640x480", help="WxH, even numbers")
     p.add_argument("--fps", type=float, default=50.0)

@@ -21,18 +21,18 @@ from experiments import storage
 from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
-from sim.config import PRESETS, STICK_RETURNS, WorldConfig, world_preset
+from models.presets import DEFAULT_PRESET, PRESETS
+from sim.config import STICK_RETURNS, WorldConfig, world_preset
+from sim.grasping.names import DEFAULT_GRASP, GRASPS
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-
-GRASPS = ("kinematic", "physical")
 
 
 @dataclass(frozen=True)
 class TrialSettings:
     """What a user chooses for one trial (`playroom run`)."""
 
-    grasp: str = "kinematic"
+    grasp: str = DEFAULT_GRASP
     iterations: int = 1000
     seed: int = 0
     babbling: str = "random"
@@ -40,7 +40,7 @@ class TrialSettings:
     stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
     # "study": the world and learner as the study's code behaved; "project": this project's
     # earlier choices (sim.config.world_preset, learner.config.learner_preset).
-    preset: str = "study"
+    preset: str = DEFAULT_PRESET
     # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
     # departure switched at a time (ablations, docs/replication.md).
     overrides: dict = dataclasses.field(default_factory=dict)

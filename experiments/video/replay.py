@@ -26,7 +26,8 @@ from learner.agent import Proposal
 from models.layout import MODELS, TOYS
 from models.world import Feedback
 from sim.dmp import voice_trajectory
-from sim.vocal.audio import synthesise, synthesise_word
+from sim.vocal.audio import synthesise
+from sim.vocal.produce import synthesise_word
 
 
 class ReplayError(Exception):

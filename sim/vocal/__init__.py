@@ -7,7 +7,9 @@ Modules, one concept each:
 - `formant_map`: the fast fitted map articulators -> (log2 F1, log2 F2), plain NumPy.
 - `words`: vowel targets, the 6 words, their perfect trajectories, recognition.
 - `produce`: voice parameters that say each word (found by optimisation).
-- `tract`: `VocalTract`, what the world uses.
+- `voice`: `Voice`, what the world uses of a vocal tract, whichever it is.
+- `tract`: `VocalTract`, VocalTractLab's tract, the study's ("vtl").
+- `registry`: the tracts by name, and `make_tract`.
 - `audio`: waveform synthesis with VTL and WAV writing.
 - `fit_voice_model`: the script that regenerates the data files in `data/`.
 """

@@ -71,17 +71,6 @@ def synthesise(
     return wave, rate
 
 
-def synthesise_word(
-    word: str, duration_s: float = DEFAULT_DURATION_S, pad_s: float = DEFAULT_PAD_S
-) -> tuple[np.ndarray, int]:
-    """The caregiver's word as audio: the stored voice parameters that produce it
-    (`sim.vocal.produce.say`) through the vocal DMP and VTL. Returns (waveform, rate Hz)."""
-    from sim.dmp import voice_trajectory
-    from sim.vocal.produce import say
-
-    return synthesise(voice_trajectory(say(word)), duration_s=duration_s, pad_s=pad_s)
-
-
 def write_wav(
     path: str | Path, waveform: np.ndarray, rate: int, peak: float | None = WAV_PEAK
 ) -> None:

@@ -22,7 +22,8 @@ from scipy.optimize import lsq_linear, minimize
 
 from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.dmp import rollout
+from sim.dmp import rollout, voice_trajectory
+from sim.vocal.audio import DEFAULT_DURATION_S, DEFAULT_PAD_S, synthesise
 from sim.vocal.tract import VocalTract
 from sim.vocal.words import word_features
 
@@ -114,3 +115,11 @@ def say(word: str) -> np.ndarray:
 def stored_distances() -> dict[str, float]:
     """Word -> feature distance of its stored production (fast map, at fit time)."""
     return {w: d for w, (_, d) in _stored().items()}
+
+
+def synthesise_word(
+    word: str, duration_s: float = DEFAULT_DURATION_S, pad_s: float = DEFAULT_PAD_S
+) -> tuple[np.ndarray, int]:
+    """The caregiver's word as audio: the stored voice parameters that produce it
+    (`say`) through the vocal DMP and VTL. Returns (waveform, rate Hz)."""
+    return synthesise(voice_trajectory(say(word)), duration_s=duration_s, pad_s=pad_s)

@@ -1,0 +1,255 @@
+"""The study's kinematic rules (docs/protocol.md §5, §6; the catch rule departs, §11), each
+written twice side by side: stepped, as the dm_control task applies it one control step at a
+time (the room's path when step observers watch, as in videos), and in closed form over a whole
+movement at once (the room's fast path). The arm follows its targets exactly and objects move
+only when held or carried, so a movement is geometry: the hand's path is the forward kinematics
+of the 50 targets in one array operation, a rule fires at the first step at which a distance
+drops below its threshold, and held objects follow the hand (or the held stick's tip) from that
+step on. tests/test_kinematic_paths.py compares the two forms on thousands of commands, sample
+by sample and event by event: change a rule in both forms here, and run it.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from models.layout import N_STEPS, TOYS
+from sim import events as ev
+from sim.grasping.base import ArmMovement, ClosedForm, arm_to_rest
+from sim.kinematics import hand_positions
+from sim.physics import PlayroomPhysics
+
+
+class KinematicPhysics(PlayroomPhysics):
+    """The study's kinematic world: a step only recomputes positions.
+
+    The grasp rules set joint and object positions directly; no dynamics run. The hand is where
+    the study's analytic forward kinematics puts it (sim/kinematics.py): the same numbers as the
+    closed form below, to the last bit. MuJoCo's own hand site agrees with it within 1e-15 m and
+    is what renders.
+    """
+
+    def step(self, nstep: int = 1) -> None:
+        mujoco.mj_kinematics(self._mj_model, self._mj_data)
+
+    def advance(self, nstep: int) -> None:
+        self.step(nstep)
+
+    def hand_position(self) -> np.ndarray:
+        return hand_positions(self.arm_angles()[:, None], self.config)[0]
+
+    def tracked_positions(self) -> np.ndarray:
+        out = super().tracked_positions()
+        out[0] = self.hand_position()
+        return out
+
+    def stick_tip(self) -> np.ndarray:
+        """The tip of the stick from its pose, by the same arithmetic as the held stick's."""
+        x, y, yaw = self.object_poses()[0]
+        return np.array([x, y]) + self.config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])
+
+
+class KinematicGrasp(ClosedForm):
+    """The arm follows its targets exactly and objects attach by distance. Held objects are
+    placed, not simulated."""
+
+    name = "kinematic"
+    physics_class = KinematicPhysics
+    solid = False
+
+    # Arm movements: the grasp and catch rules, stepped ------------------------------------
+    def before_step(
+        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
+    ) -> list[ev.Event]:
+        d = physics.data.ptr
+        d.qpos[physics.arm_qpos] = joint_targets
+        mujoco.mj_kinematics(physics.model.ptr, d)
+        events = self._attach_by_distance(physics, step)
+        self._carry(physics)
+        return events
+
+    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        return []
+
+    def _attach_by_distance(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """The study's rules: a free hand takes the stick, else the first toy within reach; the
+        stick's tip catches the first free toy within reach if it holds none: a held stick's
+        only (catch_rule "held_stick"), or the stick wherever it is ("study")."""
+        cfg = self.config
+        events: list[ev.Event] = []
+        positions = physics.tracked_positions()  # hand, handle, toy1-3
+        free = self._free_toy_mask()
+        if self.hand_holds is None:
+            near = np.hypot(*(positions[1:] - positions[0]).T) < cfg.grasp_distance
+            near[1:] &= free
+            if near.any():
+                first = int(np.argmax(near))
+                if first == 0:
+                    self.hand_holds = "stick"
+                    events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
+                else:
+                    self.hand_holds = TOYS[first - 1]
+                    free[first - 1] = False
+                    events.append(ev.Event(ev.TOY_GRASPED, step, obj=TOYS[first - 1], by="hand"))
+        held = self.hand_holds == "stick"
+        if (held or cfg.catch_rule == "study") and self.stick_holds is None:
+            tip = self._held_stick_tip(physics) if held else physics.stick_tip()
+            near = (np.hypot(*(positions[2:] - tip).T) < cfg.catch_distance) & free
+            if near.any():
+                self.stick_holds = int(np.argmax(near))
+                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=TOYS[self.stick_holds], by="stick"))
+        return events
+
+    def _held_stick_tip(self, physics: PlayroomPhysics) -> np.ndarray:
+        """The tip of the stick held by the hand: the handle is at the hand and the stick
+        points along the hand's orientation."""
+        yaw = physics.hand_angle()
+        return physics.hand_position() + self.config.stick_length * np.array(
+            [np.cos(yaw), np.sin(yaw)]
+        )
+
+    def _carry(self, physics: PlayroomPhysics) -> None:
+        """Place held objects: the handle at the hand, toys at the hand or the stick's tip."""
+        if self.hand_holds is None:
+            if self.stick_holds is not None:  # a toy caught by the lying stick, at its tip
+                poses = physics.object_poses()
+                poses[1 + self.stick_holds, :2] = physics.stick_tip()
+                physics.set_object_poses(poses)
+            return
+        poses = physics.object_poses()
+        if self.hand_holds == "stick":
+            poses[0] = (*physics.hand_position(), physics.hand_angle())
+            if self.stick_holds is not None:
+                poses[1 + self.stick_holds, :2] = self._held_stick_tip(physics)
+        else:
+            poses[1 + TOYS.index(self.hand_holds), :2] = physics.hand_position()
+        physics.set_object_poses(poses)
+
+    def release(self, physics: PlayroomPhysics) -> None:
+        self.hand_holds = None
+        self.stick_holds = None
+        arm_to_rest(physics)
+
+    # Arm movements: the same rules in closed form -----------------------------------------
+    def arm_movement(
+        self, joint_targets: np.ndarray, stick_pose: np.ndarray, toys: np.ndarray
+    ) -> ArmMovement:
+        config = self.config
+        hand = hand_positions(joint_targets, config)  # (N_STEPS, 2)
+        yaw = np.cumsum(joint_targets, axis=0)[-1] + config.arm_rest_offset  # (N_STEPS,)
+        positions = np.empty((N_STEPS, 2 + len(TOYS), 2))
+        positions[:, 0] = hand
+        positions[:, 1] = stick_pose[:2]
+        positions[:, 2:] = toys
+        events: list[ev.Event] = []
+        free = np.ones(len(TOYS), dtype=bool)
+        on_stick = None  # the toy on the stick's tip
+        # Until the hand takes something nothing moves, so every distance is to a still object.
+        near = np.empty((N_STEPS, 1 + len(TOYS)), dtype=bool)
+        near[:, 0] = np.hypot(*(stick_pose[:2] - hand).T) < config.grasp_distance
+        for i in range(len(TOYS)):
+            near[:, 1 + i] = np.hypot(*(toys[i] - hand).T) < config.grasp_distance
+        grab_steps = np.flatnonzero(near.any(axis=1))
+        k = int(grab_steps[0]) if grab_steps.size else N_STEPS  # 0-based: control step k + 1
+        first = int(np.argmax(near[k])) if k < N_STEPS else -1  # the stick first, then the toys
+        if config.catch_rule == "study" and not (k == 0 and first == 0):
+            # The lying stick's tip catches a toy at the first step or never (nothing moves
+            # before the hand takes something), after the hand's pick of that step, if any.
+            if k == 0:
+                free[first - 1] = False
+            lying_tip = stick_pose[:2] + config.stick_length * np.array(
+                [np.cos(stick_pose[2]), np.sin(stick_pose[2])]
+            )
+            caught = (np.hypot(*(toys - lying_tip).T) < config.catch_distance) & free
+            if caught.any():
+                on_stick = int(np.argmax(caught))
+                positions[:, 2 + on_stick] = lying_tip
+                free[on_stick] = False
+                events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
+                if k > 0:  # the hand's first grasp comes later: the caught toy is not free
+                    near[:, 1:] &= free
+                    grab_steps = np.flatnonzero(near.any(axis=1))
+                    k = int(grab_steps[0]) if grab_steps.size else N_STEPS
+                    first = int(np.argmax(near[k])) if k < N_STEPS else -1
+        final_stick = np.array(stick_pose, dtype=float)
+        if k == N_STEPS:
+            return ArmMovement(positions, final_stick, events, None)
+        if first > 0:
+            toy = first - 1
+            positions[k:, 2 + toy] = hand[k:]
+            events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=TOYS[toy], by="hand"))
+            return ArmMovement(positions, final_stick, _in_step_order(events), TOYS[toy])
+        events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
+        positions[k:, 1] = hand[k:]
+        final_stick = np.array([*hand[-1], yaw[-1]])
+        # The held stick points along the hand: its tip carries a toy caught before, or catches
+        # the first toy within reach.
+        tip = hand[k:] + config.stick_length * np.stack([np.cos(yaw[k:]), np.sin(yaw[k:])], 1)
+        if on_stick is not None:
+            positions[k:, 2 + on_stick] = tip
+            return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
+        caught = np.empty((N_STEPS - k, len(TOYS)), dtype=bool)
+        for i in range(len(TOYS)):
+            caught[:, i] = (np.hypot(*(toys[i] - tip).T) < config.catch_distance) & free[i]
+        catch_steps = np.flatnonzero(caught.any(axis=1))
+        if catch_steps.size:
+            c = int(catch_steps[0])
+            toy = int(np.argmax(caught[c]))
+            positions[k + c :, 2 + toy] = tip[c:]
+            events.append(ev.Event(ev.TOY_CAUGHT, k + c + 1, obj=TOYS[toy], by="stick"))
+        return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
+
+    # Vocal movements: the resting hand's grab, stepped and in closed form -----------------
+    def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """With the study's catch rule, the resting hand takes a stick whose handle lies
+        within the grasp distance (the study's code checks it in vocal movements too)."""
+        if self.config.catch_rule != "study" or self.hand_holds is not None:
+            return []
+        positions = physics.tracked_positions()
+        if np.hypot(*(positions[1] - positions[0])) >= self.config.grasp_distance:
+            return []
+        self.hand_holds = "stick"
+        self._carry(physics)
+        return [ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand")]
+
+    def voice_grasp(self, hand: np.ndarray, stick_pose: np.ndarray) -> bool:
+        """With the study's catch rule, whether the handle lies within the grasp distance."""
+        if self.config.catch_rule != "study":
+            return False
+        return bool(np.hypot(*(stick_pose[:2] - hand)) < self.config.grasp_distance)
+
+    # The caregiver bringing a toy: placed directly, stepped and in closed form ------------
+    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:
+        """Nothing to do: the toy is placed directly at every step, as in the study."""
+
+    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, target: np.ndarray) -> None:
+        rate = self.config.caregiver_bring_rate
+        poses = physics.object_poses()
+        poses[1 + toy, :2] += rate * (target - poses[1 + toy, :2])
+        physics.set_object_poses(poses)
+
+    def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
+        """Nothing to undo: the toy lies where it was last placed."""
+
+    def brought_path(self, start: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """`caregiver_carries`' arithmetic, repeated over the N_STEPS control steps."""
+        rate = self.config.caregiver_bring_rate
+        path = np.empty((N_STEPS, 2))
+        position = np.array(start, dtype=float)
+        for k in range(N_STEPS):
+            position += rate * (target - position)
+            path[k] = position
+        return path
+
+    # The experimenter ---------------------------------------------------------------------
+    def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
+        """The handle lies beyond the arm's length plus the grasp distance."""
+        cfg = self.config
+        return float(np.hypot(*physics.stick_handle())) > cfg.arm_length + cfg.grasp_distance
+
+
+def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:
+    """Events by step; within a step, the hand's grasp before the stick's catch."""
+    order = {ev.STICK_GRASPED: 0, ev.TOY_GRASPED: 0, ev.TOY_CAUGHT: 1}
+    return sorted(events, key=lambda e: (e.step, order[e.kind]))

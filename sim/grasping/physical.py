@@ -1,0 +1,137 @@
+"""Grasping through MuJoCo contacts (docs/protocol.md §11 D16): position servos track the arm's
+targets through the dynamics; the hand takes the stick when it touches the handle geom, or a toy
+when it touches it; the stick's tip catches a toy it touches. A grasp activates a weld equality
+holding the current relative pose. Unheld objects are pushed by whatever touches them. The
+caregiver carries a toy with her hand, a mocap body welded to it, lifted above the table.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from models.layout import TOYS
+from sim import events as ev
+from sim.grasping.base import GraspBackend, arm_to_rest
+from sim.kinematics import segment_distance
+from sim.physics import OBJECTS, PlayroomPhysics
+
+# The name under which the caregiver's carrying edits the model (sim/model_edits.py); the
+# grasps edit it under the backend's name.
+CAREGIVER = "caregiver"
+
+
+class PhysicalGrasp(GraspBackend):
+    """Grasps by contact, held by welds; every object a solid body."""
+
+    name = "physical"
+    physics_class = PlayroomPhysics
+    solid = True
+
+    # Arm movements ------------------------------------------------------------------------
+    def before_step(
+        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
+    ) -> list[ev.Event]:
+        physics.data.ptr.ctrl[:] = joint_targets
+        return []
+
+    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        pairs = physics.touching_pairs()
+        if len(pairs) == 0:
+            return []
+        events: list[ev.Event] = []
+        free = self._free_toy_mask()
+        if self.hand_holds is None:
+            touched = _partners(pairs, physics.hand_geom)
+            toys = np.isin(physics.toy_geoms, touched) & free
+            if physics.handle_geom in touched:
+                self.hand_holds = "stick"
+                self._hold(physics, "hand_stick", "stick")
+                events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
+            elif toys.any():
+                toy = TOYS[int(np.argmax(toys))]
+                self.hand_holds = toy
+                free[TOYS.index(toy)] = False
+                self._hold(physics, f"hand_{toy}", toy)
+                events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
+        # A stick lying on the table catches nothing: only a stick in the hand is a tool.
+        if self.hand_holds == "stick" and self.stick_holds is None:
+            toys = np.isin(physics.toy_geoms, _partners(pairs, physics.tip_geom)) & free
+            if toys.any():
+                self.stick_holds = int(np.argmax(toys))
+                toy = TOYS[self.stick_holds]
+                self._hold(physics, f"stick_{toy}", toy)
+                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=toy, by="stick"))
+        return events
+
+    def _hold(self, physics: PlayroomPhysics, weld: str, obj: str) -> None:
+        """Weld `obj` where it is to its holder, lift it off the table (no table friction while
+        carried), and stop it colliding with its holder (and only with it).
+
+        MuJoCo makes a contact when one geom's contype meets the other's conaffinity, so a
+        holder and its object each lose the other's bit from their conaffinity.
+        """
+        self.edits.weld_here(self.name, weld)
+        self.edits.lift(self.name, OBJECTS.index(obj))
+        holder = weld.split("_")[0]
+        holder_geoms = [physics.hand_geom] if holder == "hand" else list(physics.stick_geoms)
+        object_geoms = (
+            list(physics.stick_geoms) if obj == "stick" else [physics.toy_geoms[TOYS.index(obj)]]
+        )
+        # The collision bit of a kind of geom is its contype in the MJCF model.
+        holder_bit = self.edits.compiled_contype(holder_geoms[0])
+        object_bit = self.edits.compiled_contype(object_geoms[0])
+        for geom in holder_geoms:
+            self.edits.ignore(self.name, geom, object_bit)
+        for geom in object_geoms:
+            self.edits.ignore(self.name, geom, holder_bit)
+
+    def release(self, physics: PlayroomPhysics) -> None:
+        self.hand_holds = None
+        self.stick_holds = None
+        self.edits.clear(self.name)
+        physics.data.ptr.qvel[physics.object_dof] = 0.0
+        arm_to_rest(physics)
+
+    # The caregiver bringing a toy ---------------------------------------------------------
+    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:
+        m, d = physics.model.ptr, physics.data.ptr
+        hand = physics.caregiver_hand_mocap
+        d.mocap_pos[hand, :2] = physics.toy_positions()[toy]
+        mujoco.mj_kinematics(m, d)
+        # Her hand sits on the toy: the weld holds it there, upright.
+        self.edits.weld_here(CAREGIVER, f"caregiver_{TOYS[toy]}", keep_orientation=False)
+        # She lifts the toy: while carried it touches nothing, as a toy carried above the
+        # table would not (dragged along the table it would sweep the stick out of reach).
+        self.edits.make_intangible(CAREGIVER, physics.toy_geoms[toy])
+        self.edits.lift(CAREGIVER, OBJECTS.index(TOYS[toy]))
+
+    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, target: np.ndarray) -> None:
+        """Her hand moves; the weld brings the toy along through the dynamics."""
+        rate = self.config.caregiver_bring_rate
+        d = physics.data.ptr
+        hand = physics.caregiver_hand_mocap
+        d.mocap_pos[hand, :2] += rate * (target - d.mocap_pos[hand, :2])
+
+    def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
+        self.edits.clear(CAREGIVER)
+        d = physics.data.ptr
+        d.qvel[physics.object_dof] = 0.0
+        d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
+
+    # The experimenter ---------------------------------------------------------------------
+    def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
+        """No point of the handle geom lies within the arm's length plus the radii of the hand
+        sphere and of the handle: contact is impossible."""
+        m, d = physics.model.ptr, physics.data.ptr
+        handle = physics.handle_geom
+        axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z
+        centre, half = d.geom_xpos[handle, :2], m.geom_size[handle, 1]
+        nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
+        contact = m.geom_size[physics.hand_geom, 0] + m.geom_size[handle, 0]
+        return nearest > self.config.arm_length + contact
+
+
+def _partners(pairs: np.ndarray, geom: int) -> np.ndarray:
+    """Geoms in contact with `geom`, from (n, 2) contact pairs."""
+    return np.concatenate([pairs[pairs[:, 0] == geom, 1], pairs[pairs[:, 1] == geom, 0]])

@@ -1,0 +1,120 @@
+"""The grasp backends and vocal tracts come from their registries, and every entry point takes
+one default backend and one default preset (models/presets.py, sim/grasping/names.py)."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from experiments.batches.spec import BatchSpec
+from experiments.cli.args import RUN_DEFAULTS
+from experiments.cli.main import build_parser
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_files import TrialError
+from learner.agent import Agent
+from learner.config import BABBLING_MODES, learner_preset
+from models.layout import ARM_DIM
+from models.presets import DEFAULT_PRESET, PRESETS
+from sim import Playroom
+from sim.config import DEFAULT_WORLD, STICK_RETURNS, world_preset
+from sim.grasping import registry
+from sim.grasping.kinematic import KinematicGrasp
+from sim.grasping.names import DEFAULT_GRASP, GRASPS
+from sim.vocal.config import DEFAULT_VOICE
+from sim.vocal.registry import DEFAULT_TRACT, TRACTS, make_tract
+from sim.vocal.voice import Voice
+
+
+def test_every_backend_is_registered_under_its_own_name_in_the_light_list():
+    assert tuple(registry.BACKENDS) == GRASPS
+    for name, cls in registry.BACKENDS.items():
+        assert cls.name == name
+    assert DEFAULT_GRASP in GRASPS
+
+
+def test_an_unknown_backend_or_tract_is_refused_naming_the_choices():
+    with pytest.raises(ValueError, match="'kinematic', 'physical'"):
+        registry.backend_class("magnetic")
+    with pytest.raises(ValueError, match="'vtl'"):
+        make_tract("diva?", exact=False, config=DEFAULT_VOICE, world=DEFAULT_WORLD)
+
+
+def test_a_backend_added_to_the_registry_is_built_and_run_by_the_room(monkeypatch):
+    """The room branches on no backend name: a new registered class is all it takes."""
+
+    class Copy(KinematicGrasp):
+        name = "kinematic_copy"
+
+    monkeypatch.setitem(registry.BACKENDS, Copy.name, Copy)
+    rng = np.random.default_rng(0)
+    copy, original = Playroom(Copy.name, seed=4), Playroom("kinematic", seed=4)
+    assert isinstance(copy.backend, Copy)
+    for _ in range(20):
+        m = rng.uniform(-1, 1, ARM_DIM)
+        a, b = copy.act_arm(m), original.act_arm(m)
+        np.testing.assert_array_equal(a.s, b.s)
+        assert a.events == b.events
+
+
+def test_the_room_takes_its_voice_from_the_tract_registry():
+    room = Playroom(seed=0)
+    assert isinstance(room.vocal_tract, Voice)
+    assert type(room.vocal_tract) is TRACTS[DEFAULT_TRACT]
+    assert room.vocal_tract.name == DEFAULT_TRACT
+    assert room.vocal_tract.world == room.config
+
+
+def test_room_agent_trial_and_batch_share_one_default_backend_and_preset():
+    room = Playroom()
+    assert room.grasp == DEFAULT_GRASP == "kinematic"
+    assert DEFAULT_PRESET == "study"
+    assert room.config == world_preset(DEFAULT_PRESET)
+    assert Agent().config == learner_preset(DEFAULT_PRESET)
+    trial = TrialSettings()
+    assert (trial.grasp, trial.preset) == (DEFAULT_GRASP, DEFAULT_PRESET)
+    assert (RUN_DEFAULTS["grasp"], RUN_DEFAULTS["preset"]) == (DEFAULT_GRASP, DEFAULT_PRESET)
+    assert BatchSpec().preset == DEFAULT_PRESET
+    # A run's other defaults are those of its world and learner.
+    assert RUN_DEFAULTS["stick_return"] == room.config.stick_return
+    assert RUN_DEFAULTS["babbling"] == Agent().config.babbling
+
+
+def _options(command: str) -> dict[str, argparse.Action]:
+    """The options of a `playroom` subcommand by destination."""
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return {action.dest: action for action in sub.choices[command]._actions}
+
+
+@pytest.mark.parametrize("command", ["random", "run", "render"])
+def test_the_command_line_offers_the_registered_backends(command):
+    grasp = _options(command)["grasp"]
+    assert tuple(grasp.choices) == GRASPS
+    # `run` leaves settings out (a resumed trial keeps its own); the others default.
+    assert grasp.default == (None if command == "run" else DEFAULT_GRASP)
+
+
+def test_the_command_line_offers_each_settings_declared_values():
+    run = _options("run")
+    assert tuple(run["preset"].choices) == PRESETS
+    assert tuple(run["babbling"].choices) == BABBLING_MODES
+    assert tuple(run["stick_return"].choices) == STICK_RETURNS
+
+
+def test_the_command_line_builds_its_parser_without_the_simulator_or_the_learner():
+    code = (
+        "import sys; from experiments.cli.main import build_parser; build_parser(); "
+        "print(sorted(m for m in ('mujoco', 'dm_control', 'numba') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_a_trial_refuses_a_backend_the_registry_does_not_know():
+    with pytest.raises(TrialError, match="kinematic, physical"):
+        dataclasses.replace(TrialSettings(), grasp="magnetic")
