@@ -1,7 +1,7 @@
 """What a world is to the learner: a context, and feedback for a command in a motor space.
 
-`sim.Playroom` (the MuJoCo playroom) and `learner.synthetic.SyntheticWorld` (a cheap stand-in
-for the learner's own tests) both implement `World`; the trial loop, evaluation, replay and
+`sim.Playroom` (the MuJoCo playroom) and `SyntheticWorld` (tests/synthetic.py, a cheap
+stand-in for the learner's own tests) both implement `World`; the trial loop, evaluation, replay and
 video drive either through `act`, and nothing else dispatches on the motor space.
 """
 

@@ -89,7 +89,7 @@ def _integrate_study(
 
 
 @functools.lru_cache(maxsize=8)
-def _response_matrix(n_bfs: int, n_steps: int, kind: str = "project") -> np.ndarray:
+def response_matrix(n_bfs: int, n_steps: int, kind: str = "project") -> np.ndarray:
     """(2 + n_bfs, n_steps): the trajectory of a unit start, a unit end and each unit weight.
 
     The DMP is linear in (start, end, weights) from rest velocity, so integrating each unit
@@ -116,7 +116,7 @@ def rollout(
     """
     weights = np.atleast_2d(np.asarray(weights, dtype=float))
     inputs = np.column_stack([np.asarray(start, float), np.asarray(end, float), weights])
-    return inputs @ _response_matrix(weights.shape[1], n_steps, kind)
+    return inputs @ response_matrix(weights.shape[1], n_steps, kind)
 
 
 def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:

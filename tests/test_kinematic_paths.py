@@ -12,12 +12,12 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scripted import Waypoint, arm_command_through
 
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
 from sim.config import DEFAULT_WORLD
-from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.config import DEFAULT_VOICE
 from sim.vocal.produce import say
 

@@ -7,13 +7,13 @@ import copy
 
 import numpy as np
 import pytest
+from synthetic import SyntheticWorld
 
-from learner import bench
+from experiments.bench import learner as bench
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from learner.interest import InterestModel
 from learner.sensorimotor_model import MODELS, SensorimotorModel
-from learner.synthetic import SyntheticWorld
 from sim.config import DEFAULT_WORLD
 from sim.vocal.config import DEFAULT_VOICE
 

@@ -11,13 +11,13 @@ import mujoco
 import numpy as np
 import pytest
 from scipy.io import wavfile
+from scripted import Waypoint, arm_command_through
 
 from experiments.video import encoding, episodes, recording, sound
 from experiments.video.overlay import CameraView
 from models.layout import N_STEPS, VOICE_DIM
 from sim import Playroom
 from sim.config import world_preset
-from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.audio import write_wav
 
 # The world these tests were written for: the project preset (explicit, as Playroom() takes

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.io import wavfile
+from scripted import Waypoint, arm_command_through
 
 from experiments.cli.main import main
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
 from sim.config import world_preset
-from sim.scripted import Waypoint, arm_command_through
 from sim.vocal.produce import say
 from sim.vocal.words import word_distances, word_features
 

@@ -6,6 +6,7 @@ import mujoco
 import numpy as np
 import pytest
 from dm_control.rl import control
+from scripted import Waypoint, arm_command_through
 
 from models.layout import ARM_BASIS_FUNCTIONS, ARM_DIM, N_STEPS, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim import Playroom
@@ -14,7 +15,6 @@ from sim.config import DEFAULT_WORLD, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.kinematics import hand_positions
 from sim.physics import PlayroomPhysics
-from sim.scripted import Waypoint, arm_command_through
 
 # The world these tests were written for: the project preset (explicit, as Playroom() takes
 # the default preset, the study's).

@@ -13,10 +13,10 @@ from collections.abc import Callable, Iterator
 import mujoco
 import numpy as np
 
+from experiments.bench.tracking import hand_tracking_errors
 from models.layout import ARM_DIM, N_STEPS, SAMPLE_INDICES
 from sim import Playroom
 from sim.physics import CONTROL_SUBSTEPS
-from sim.tracking import hand_tracking_errors
 
 # Targets of the trial and learner figures (ratios to 500 bare mj_step; ms).
 TRIAL_TARGETS = {"kinematic": 0.25, "physical": 1.6}
@@ -106,7 +106,7 @@ def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
 def learner_figures(sizes: tuple[int, ...] = LEARNER_SIZES) -> Iterator[tuple[str, float, str]]:
     """The memory's query against brute force, and the learner's own cost per iteration with
     every model holding 10000, 40000 and 80000 experiences."""
-    from learner import bench as learner_bench
+    from experiments.bench import learner as learner_bench
 
     largest = max(sizes)
     query = learner_bench.query_ratio(n_rows=largest)
@@ -123,7 +123,7 @@ def learner_figures(sizes: tuple[int, ...] = LEARNER_SIZES) -> Iterator[tuple[st
 def learner_costs(sizes: tuple[int, ...]) -> dict[int, float]:
     """Seconds per iteration of propose + learn with every model holding n rows, per n; the
     experiences come from the study's kinematic world, whose own time is not counted."""
-    from learner import bench as learner_bench
+    from experiments.bench import learner as learner_bench
 
     return {
         n: learner_bench.learner_overhead(Playroom("kinematic", seed=1), n_rows=n)["mean_s"]

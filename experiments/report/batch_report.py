@@ -21,7 +21,7 @@ from experiments.file_names import COMPARISON_FILE, REPORT_FILE
 from experiments.report import name_strategies, paper
 from experiments.report.comparison import write_comparison
 from experiments.report.figures import report_figures
-from experiments.report.html import render, settings_table, trials_table, where_table, write_page
+from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
 
 # The CLI imports ReportError, write_report and write_comparison from here.

@@ -39,7 +39,7 @@ from experiments.analysis.stats import (
 from experiments.file_names import COMPARISON_FILE
 from experiments.report import name_strategies, paper
 from experiments.report.figures import FigureFile, report_figures
-from experiments.report.html import (
+from experiments.report.pages import (
     Table,
     ci_text,
     num,

@@ -17,7 +17,7 @@ import pandas as pd
 
 from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import STRATEGIES
-from experiments.report.html import Table, pct
+from experiments.report.pages import Table, pct
 
 NOT_RECORDED = (
     "Not shown: some trials were evaluated before the vocal table recorded which toy each "

@@ -19,7 +19,7 @@ from typing import Any
 from experiments.analysis.results import BatchResults, Geometry
 from experiments.analysis.stats import DISTANCE_ONE
 from experiments.analysis.study_summary import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
-from experiments.report.html import Table, ci_text, num, p_value, pct, shares_text
+from experiments.report.pages import Table, ci_text, num, p_value, pct, shares_text
 
 PAPER_FILE = "paper.json"
 # A number the paper does not give (per ring competence): said so, not left blank.

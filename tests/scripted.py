@@ -15,7 +15,7 @@ from scipy.optimize import lsq_linear
 
 from models.layout import ARM_BASIS_FUNCTIONS, N_JOINTS, N_STEPS
 from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.dmp import _response_matrix, arm_trajectory
+from sim.dmp import arm_trajectory, response_matrix
 from sim.kinematics import hand_positions
 
 WAYPOINT_WEIGHT = 10.0
@@ -68,7 +68,7 @@ def arm_command_through(
     """The (21,) command in [-1, 1] whose hand follows the waypoints, and its error: the largest
     distance (m) between the hand and a waypoint, on the analytic kinematics."""
     path, angles = _hand_path(waypoints, config)
-    response = _response_matrix(ARM_BASIS_FUNCTIONS, N_STEPS, config.dmp)  # start, end, weights
+    response = response_matrix(ARM_BASIS_FUNCTIONS, N_STEPS, config.dmp)  # start, end, weights
     # Per joint, the trajectory (before clipping, in units of pi) is end * R[1] + w @ R[2:].
     design = np.vstack([response[1], config.dmp_weight_scale * response[2:]]).T
     # The waypoints matter more than the straight lines drawn between them.
