@@ -1,4 +1,4 @@
-"""The reference trials that tests/test_reference_logs.py compares against, and how they are
+"""The reference trials that tests/run/test_reference_logs.py compares against, and how they are
 recorded again.
 
 A reference trial is 2000 iterations of seed 11 under the project preset with the stick return

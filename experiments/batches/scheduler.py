@@ -126,7 +126,9 @@ def connect(scheduler: str | None, n_workers: int | None):
         n_workers=n_workers or os.cpu_count() or 1,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        # Any free port: with None, distributed still serves HTTP on 8787 and warns when
+        # another batch on this machine holds it.
+        dashboard_address=":0",
         silence_logs=logging.ERROR,
     )
     return Client(cluster), cluster

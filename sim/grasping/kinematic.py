@@ -5,7 +5,7 @@ movement at once (the room's fast path). The arm follows its targets exactly and
 only when held or carried, so a movement is geometry: the hand's path is the forward kinematics
 of the 50 targets in one array operation, a rule fires at the first step at which a distance
 drops below its threshold, and held objects follow the hand (or the held stick's tip) from that
-step on. tests/test_kinematic_paths.py compares the two forms on thousands of commands, sample
+step on. tests/world/test_kinematic_paths.py compares the two forms on thousands of commands, sample
 by sample and event by event: change a rule in both forms here, and run it.
 """
 

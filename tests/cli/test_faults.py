@@ -142,7 +142,7 @@ def test_disk_full_during_eval_leaves_the_evaluation_as_it_was(
 
 @pytest.fixture
 def light_figures(monkeypatch):
-    """Reports draw two tiny figures instead of their real ones (tests/test_report.py checks
+    """Reports draw two tiny figures instead of their real ones (tests/report/test_report.py checks
     those): what is checked here is how the files are written."""
     from experiments.report import batch_report, comparison
 

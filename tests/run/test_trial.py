@@ -29,7 +29,7 @@ from sim.kinematics import hand_positions
 PROJECT = world_preset("project")
 
 PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
-REPO = Path(__file__).parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _run_cli(*args: str) -> subprocess.CompletedProcess:

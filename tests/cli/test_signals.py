@@ -23,7 +23,7 @@ from experiments.run.lock import DirectoryLock
 
 # -X faulthandler: a run that outlives its signal shows where it was (SIGABRT below).
 PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli.main"]
-REPO = Path(__file__).parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _checkpointed(trial: Path) -> int:

@@ -60,7 +60,7 @@ def _random_commands(rng: np.random.Generator, n: int) -> list[tuple[str, np.nda
 
 
 # 2000 commands a preset (about 15 s each on 2 cores): the quick suite keeps the scripted
-# scenes below and the kinematic reference trial (tests/test_reference_logs.py), which runs
+# scenes below and the kinematic reference trial (tests/run/test_reference_logs.py), which runs
 # the closed form for 2000 iterations; `make test-slow` runs these.
 @pytest.mark.slow
 @pytest.mark.parametrize("config", [DEFAULT_WORLD, STUDY_WORLD], ids=["project", "study"])

@@ -114,7 +114,7 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     ):
         assert statistic in text, statistic
     assert (out / "comparison-stick.png").exists()
-    # Where the trials ran (tests/test_provenance.py): all here, counted per side.
+    # Where the trials ran (tests/run/test_provenance.py): all here, counted per side.
     section = text.split("<h2>Where the trials ran</h2>")[1].split("<h2>")[0]
     assert "<td>3 (kinematic 2, physical 1)</td><td>3 (kinematic 2, physical 1)</td>" in section
 

@@ -8,6 +8,7 @@ import dataclasses
 import json
 import math
 import shutil
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -148,21 +149,23 @@ def test_each_ablation_config_changes_one_setting_of_its_preset():
     from experiments.batches.spec import load_spec
     from experiments.run.settings import full_config
 
-    folder = Path(__file__).parent.parent / "experiments" / "ablations"
-    files = sorted(folder.glob("*.json"))
-    names = {f.stem for f in files}
+    folder = resources.files("experiments.batches").joinpath("ablations")
+    files = sorted((f for f in folder.iterdir() if f.name.endswith(".json")), key=lambda f: f.name)
+    assert len(files) >= 3, f"no shipped ablation configs in {folder}"
+    names = {f.name.removesuffix(".json") for f in files}
     assert {f"project-plus-{n}" for n in names if not n.startswith("project")} <= names
     for path in files:
-        spec = load_spec(config_file=path)
+        spec = load_spec(config_file=Path(str(path)))
         assert spec.seeds == tuple(range(32)) and spec.iterations == 80000
         (name, settings), *_ = spec.trials()
         preset = dataclasses.replace(settings, overrides={})
         changes = config_differences(full_config(preset), full_config(settings))
         changes = [c for c in changes if not c[0].startswith("trial.overrides")]
-        if path.stem == "project":
+        stem = path.name.removesuffix(".json")
+        if stem == "project":
             assert settings.preset == "project" and changes == []
             continue
-        assert settings.preset == ("project" if path.stem.startswith("project") else "study")
+        assert settings.preset == ("project" if stem.startswith("project") else "study")
         assert len(changes) == 1, f"{path.name} changes {changes}"
         key, _, value = changes[0]
         other = "study" if settings.preset == "project" else "project"
