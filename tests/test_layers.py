@@ -1,5 +1,6 @@
-"""Reading results and drawing pages load no simulator: analysis runs on any machine, quickly
-(the layering itself is checked by `make lint`: pyproject.toml's [tool.importlinter])."""
+"""What an import loads: reading results, drawing pages, building the command line's parser and
+recording provenance load no simulator, so that they run on any machine, quickly (the layering
+itself is checked by `make lint`: pyproject.toml's [tool.importlinter])."""
 
 from __future__ import annotations
 
@@ -8,15 +9,30 @@ import sys
 
 import pytest
 
-HEAVY = ("mujoco", "dm_control", "numba", "sim", "learner")
+SIMULATOR = ("mujoco", "dm_control", "numba", "sim", "learner")
 
 
 @pytest.mark.parametrize(
-    "module",
-    ["experiments.analysis.results", "experiments.analysis.stats", "experiments.report.comparison"],
+    "statement, not_loaded",
+    [
+        ("import experiments.analysis.results", SIMULATOR),
+        ("import experiments.analysis.stats", SIMULATOR),
+        ("import experiments.report.comparison", SIMULATOR),
+        # The parser reads the settings' allowed values from sim.config and learner.config.
+        (
+            "from experiments.cli.main import build_parser; build_parser()",
+            ("mujoco", "dm_control", "numba"),
+        ),
+        (
+            "from experiments.provenance import machine_record; machine_record()",
+            ("mujoco", "dm_control", "pandas"),
+        ),
+    ],
 )
-def test_analysis_and_reports_import_no_simulator(module):
-    code = f"import sys, {module}; print(' '.join(m for m in {HEAVY!r} if m in sys.modules))"
+def test_an_import_loads_only_what_it_needs(statement, not_loaded):
+    code = (
+        f"import sys; {statement}; print(' '.join(m for m in {not_loaded!r} if m in sys.modules))"
+    )
     loaded = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
