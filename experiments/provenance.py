@@ -308,7 +308,7 @@ def record_start(trial_dir: str | os.PathLike, iteration: int) -> list[str]:
     """Append this machine's entry, computing from `iteration` on, to the trial's
     provenance.json (written atomically; the caller holds the trial's lock). Entries from
     `iteration` on are dropped: a resume discarded what they computed. Returns the lines to
-    tell the user: the machine or libraries changed since the previous entry, or a damaged
+    tell the user: the code, machine or libraries changed since the previous entry, or a damaged
     provenance.json was kept aside."""
     from experiments import storage
 
@@ -337,9 +337,9 @@ def record_start(trial_dir: str | os.PathLike, iteration: int) -> list[str]:
                 f" and {len(changes) - 3} more" if changes[3:] else ""
             )
             notices.append(
-                f"machine or libraries changed since iteration {previous['from_iteration']} "
+                f"code, machine or libraries changed since iteration {previous['from_iteration']} "
                 f"({shown}): its iterations from {iteration} on may differ in their last bits "
-                f"from a run on the earlier machine (recorded in {PROVENANCE_FILE})"
+                f"from a run before it (recorded in {PROVENANCE_FILE})"
             )
     return notices
 
