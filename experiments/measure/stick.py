@@ -21,6 +21,7 @@ from models.layout import ARM_DIM, TOYS
 from sim import Playroom
 from sim import events as ev
 from sim.config import DEFAULT_WORLD
+from sim.grasping.names import GRASPS
 
 # What can touch the stick, as push_sources names it.
 SOURCES = ("hand", "toy held by the hand", "free toy", "nothing")
@@ -82,7 +83,7 @@ def grasp_rates(n_commands: int = 1000, seed: int = 0) -> dict[str, float]:
     commands = rng.uniform(-1.0, 1.0, (n_commands, ARM_DIM))
     start = (*DEFAULT_WORLD.stick_start_handle, DEFAULT_WORLD.stick_start_angle)
     rates = {}
-    for grasp in ("kinematic", "physical"):
+    for grasp in GRASPS:
         config = dataclasses.replace(DEFAULT_WORLD, stick_return="never")
         room = Playroom(grasp, seed=seed, config=config)
         toys = room.context()[2:8].reshape(3, 2)
