@@ -16,9 +16,9 @@ from typing import TypeGuard
 from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
-from learner.config import BABBLING_MODES
+from learner.config import BABBLING_MODES, LearnerConfig
 from models.presets import DEFAULT_PRESET, PRESETS
-from sim.config import STICK_RETURNS
+from sim.config import STICK_RETURNS, WorldConfig
 from sim.grasping.names import GRASPS
 
 
@@ -57,12 +57,12 @@ class BatchSpec:
     here, without coercion: a batch is refused before anything is written or started."""
 
     grasps: tuple[str, ...] = GRASPS
-    babbling: tuple[str, ...] = ("random",)
+    babbling: tuple[str, ...] = (LearnerConfig.babbling,)
     seeds: tuple[int, ...] = (0, 1, 2)
     iterations: int = 1000
     checkpoint_every: int = 1000
     eval_placements: int = 100
-    stick_return: str = "out_of_reach"
+    stick_return: str = WorldConfig.stick_return
     preset: str = DEFAULT_PRESET
     overrides: dict = field(default_factory=dict)
     description: str = field(default="", compare=False)

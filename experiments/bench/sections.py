@@ -185,11 +185,12 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
         yield f"paper_profile_on_{cores}_cores", total / cores / 3600, "h (running, projected)"
 
 
-def render_figures() -> Iterator[tuple[str, float, str]]:
-    """Offscreen rendering speed (needs an OpenGL backend: the CLI chooses it first)."""
-    from experiments.video import episodes
+def render_section() -> Iterator[tuple[str, float, str]]:
+    """Offscreen rendering speed (needs an OpenGL backend: the CLI chooses it before the
+    rendering modules are imported)."""
+    from experiments.bench.render import render_figures
 
-    yield from episodes.render_figures()
+    yield from render_figures()
 
 
 def _peak_rss_mb() -> float:
@@ -204,7 +205,7 @@ SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "world": world_figures,
     "tracking": tracking_figures,
     "voice": voice_figures,
-    "render": render_figures,
+    "render": render_section,
 }
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any, NoReturn
 
+from learner.config import LearnerConfig
 from models.presets import DEFAULT_PRESET
 from sim.config import DEFAULT_WORLD
 from sim.grasping.names import DEFAULT_GRASP
@@ -15,7 +16,7 @@ RUN_DEFAULTS: dict[str, Any] = {
     "grasp": DEFAULT_GRASP,
     "iterations": 80000,
     "seed": 0,
-    "babbling": "random",
+    "babbling": LearnerConfig.babbling,
     "checkpoint_every": 1000,
     "stick_return": DEFAULT_WORLD.stick_return,
     "preset": DEFAULT_PRESET,

@@ -1,10 +1,9 @@
-"""Reports of a batch of trials: its results beside the paper's (`playroom report DIR`) and two
-batches side by side (`playroom compare DIR_A DIR_B --out DIR`, in
-`experiments.report.comparison`).
+"""The report of a batch of trials: its results beside the paper's (`playroom report DIR`);
+two batches side by side are experiments/report/comparison.py's.
 
-The work is split by job: `results` reads a batch directory into tables, `statistics`
-computes on them, `paper` holds the paper's published numbers, `figures` draws, and
-`report_html` renders the page from templates. Everything is computed and rendered in memory
+The work is split by job: `analysis.results` reads a batch directory into tables,
+`analysis.stats` computes on them, `paper` holds the paper's published numbers, `figures`
+draws, and `pages` renders the page from templates. Everything is computed and rendered in memory
 first and the files are then written as one unit (`storage.write_files`), so a failing report
 (bad input, a full disk) leaves nothing behind.
 """
@@ -14,18 +13,14 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments.analysis.results import Geometry, ReportError, check_out_dir, collect
+from experiments.analysis.results import Geometry, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import summarise_batch
-from experiments.file_names import COMPARISON_FILE, REPORT_FILE
+from experiments.file_names import REPORT_FILE
 from experiments.report import name_strategies, paper
-from experiments.report.comparison import write_comparison
 from experiments.report.figures import report_figures
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
-
-# The CLI imports ReportError, write_report and write_comparison from here.
-__all__ = ["COMPARISON_FILE", "REPORT_FILE", "ReportError", "write_comparison", "write_report"]
 
 
 def write_report(

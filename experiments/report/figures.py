@@ -278,7 +278,7 @@ def competence_by_ring(
     trials: pd.DataFrame, summary: pd.DataFrame, groups: list[str], paper_mean: float
 ) -> Figure:
     """Per-trial normalised competence, overall and per ring (dots), with the means and 95%
-    intervals of `summary` (group, scope, mean, low, high: `statistics.competence_summary`)."""
+    intervals of `summary` (group, scope, mean, low, high: `stats.competence_summary`)."""
     scopes = list(dict.fromkeys(summary["scope"]))
     fig = Figure(figsize=(9.0, 4.6), layout="constrained")
     ax = fig.subplots()

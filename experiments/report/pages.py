@@ -53,7 +53,7 @@ def p_value(p: float) -> str:
 
 
 def ci_text(row: pd.Series) -> str:
-    """A row of `statistics.competence_summary` as "mean [95% CI low, high] (n=...)"."""
+    """A row of `stats.competence_summary` as "mean [95% CI low, high] (n=...)"."""
     if not np.isfinite(row["mean"]):
         return "n/a"
     if not np.isfinite(row["low"]):
@@ -63,7 +63,7 @@ def ci_text(row: pd.Series) -> str:
 
 
 def shares_text(row: pd.Series) -> str:
-    """A row of `statistics.strategy_table` as "hand / tool / vocal (n=... tests)"."""
+    """A row of `stats.strategy_table` as "hand / tool / vocal (n=... tests)"."""
     if row["n"] == 0:
         return "no tests here"
     shares = " / ".join(pct(row[s]) for s in STRATEGIES)

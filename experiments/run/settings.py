@@ -35,9 +35,9 @@ class TrialSettings:
     grasp: str = DEFAULT_GRASP
     iterations: int = 1000
     seed: int = 0
-    babbling: str = "random"
+    babbling: str = LearnerConfig.babbling  # the one default, beside the setting
     checkpoint_every: int = 1000
-    stick_return: str = "out_of_reach"  # the experimenter's rule (sim/experimenter.py)
+    stick_return: str = WorldConfig.stick_return  # the experimenter's rule (sim/experimenter.py)
     # "study": the world and learner as the study's code behaved; "project": this project's
     # earlier choices (sim.config.world_preset, learner.config.learner_preset).
     preset: str = DEFAULT_PRESET

@@ -24,36 +24,18 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from experiments.video.encoding import FrameEncoder, RenderError, mux_into_place
+from experiments.video.encoding import FrameEncoder, mux_into_place
 from experiments.video.overlay import Caption, Overlay
 from experiments.video.recording import (
     CAMERAS,
     DEFAULT_SIZE,
     FrameRecorder,
     parse_size,
-    render_figures,
 )
 from experiments.video.sound import AUDIO_RATE, Clip, write_track
 from models.layout import ARM_DIM, N_STEPS, VOICE_DIM
 from sim import Feedback, Playroom
 from sim import events as ev
-
-# What other modules import from here (the CLI, the benchmark, the replay), wherever it lives.
-__all__ = [
-    "CAMERAS",
-    "DEFAULT_FPS",
-    "DEFAULT_SIZE",
-    "HOLD_FRAMES",
-    "LEAD_FRAMES",
-    "EpisodeRenderer",
-    "FrameRecorder",
-    "RenderError",
-    "check_output_path",
-    "film_iteration",
-    "parse_size",
-    "render_figures",
-    "render_random",
-]
 
 # 50 frames per second shows one 50-step movement in 1 s, which is also its simulated time
 # (20 ms control steps).

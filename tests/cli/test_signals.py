@@ -34,10 +34,18 @@ def _checkpointed(trial: Path) -> int:
         return 0
 
 
+def _interruptible() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _stop_after(command: list[str], trial: Path, past: int, signum: int, **popen) -> tuple:
     """Start `command`, send `signum` once the trial has a checkpoint past iteration `past`;
     (exit code, stderr)."""
-    proc = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, cwd=REPO, **popen)
+    # As from a terminal: Ctrl-C interrupts. A pytest-xdist worker ignores SIGINT, and a child
+    # inherits that (a process started ignoring SIGINT, as under nohup, is meant to ignore it).
+    proc = subprocess.Popen(
+        command, stderr=subprocess.PIPE, text=True, cwd=REPO, preexec_fn=_interruptible, **popen
+    )
     for _ in range(1200):  # polls every 25 ms; no clock is read
         if _checkpointed(trial) > past or proc.poll() is not None:
             break
