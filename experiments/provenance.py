@@ -39,7 +39,9 @@ COMPUTING = (
 # Recorded, not compared: they store and read results, they compute none of them.
 RECORDED_ONLY = ("pandas", "pyarrow", "threadpoolctl")
 # Environment variables that change what the libraries compute with (SIMD paths, BLAS
-# kernels, numba's target CPU, hash order), recorded when set. Thread counts are left out:
+# kernels, numba's target CPU), recorded when set. PYTHONHASHSEED is left out: a trial
+# resumed in a new process (another hash seed) gives the same bits (tests/run/test_trial.py),
+# and pytest-xdist sets it in its workers. Thread counts are left out:
 # Dask's nanny sets OMP_NUM_THREADS=1 and its kin in batch workers, and a trial's matrices
 # are too small for OpenBLAS to split (a split would not reorder a sum anyway).
 BIT_ENVIRONMENT = (
@@ -52,7 +54,6 @@ BIT_ENVIRONMENT = (
     "NUMBA_CPU_FEATURES",
     "NUMBA_OPT",
     "NUMBA_DISABLE_JIT",
-    "PYTHONHASHSEED",
 )
 GIT_TIMEOUT_S = 5
 INSTALLED = "installed package"

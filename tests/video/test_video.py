@@ -185,12 +185,12 @@ def test_mix_audio_places_resamples_and_clips():
 @pytest.mark.parametrize("size", ["0x120", "160", "abc", "161x120", (160,), (160.0, 120), (-2, 4)])
 def test_bad_size_is_refused(size):
     with pytest.raises(ValueError, match="size"):
-        episodes.parse_size(size)
+        recording.parse_size(size)
 
 
 def test_size_text_is_parsed():
-    assert episodes.parse_size("640x480") == (640, 480)
-    assert episodes.parse_size((160, 120)) == (160, 120)
+    assert recording.parse_size("640x480") == (640, 480)
+    assert recording.parse_size((160, 120)) == (160, 120)
 
 
 def test_bad_output_fails_before_rendering(tmp_path, monkeypatch):
@@ -212,7 +212,7 @@ def test_bad_output_fails_before_rendering(tmp_path, monkeypatch):
 def test_failed_mux_is_a_render_error(tmp_path):
     wav = tmp_path / "sound.wav"
     write_wav(wav, np.zeros(100), 8000)
-    with pytest.raises(episodes.RenderError, match="ffmpeg failed"):
+    with pytest.raises(encoding.RenderError, match="ffmpeg failed"):
         encoding.mux(tmp_path / "no_such_video.mp4", wav, tmp_path / "out.mp4")
 
 
@@ -227,7 +227,7 @@ def test_missing_gl_names_mujoco_gl_and_its_choices(monkeypatch):
 
     monkeypatch.setattr(recording.mujoco, "Renderer", no_gl)
     room = Playroom(grasp="kinematic", seed=0, config=PROJECT)
-    with pytest.raises(episodes.RenderError, match="MUJOCO_GL to one of egl, osmesa, glfw"):
+    with pytest.raises(encoding.RenderError, match="MUJOCO_GL to one of egl, osmesa, glfw"):
         recording.FrameRecorder(room, SIZE)
 
 
@@ -317,7 +317,7 @@ def test_failed_mux_leaves_the_old_file_whole(tmp_path):
     out = tmp_path / "video.mp4"
     out.write_bytes(b"an older video")
     write_wav(tmp_path / "sound.wav", np.zeros(100), 8000)
-    with pytest.raises(episodes.RenderError, match="ffmpeg failed"):
+    with pytest.raises(encoding.RenderError, match="ffmpeg failed"):
         encoding.mux_into_place(tmp_path / "missing.mp4", tmp_path / "sound.wav", out)
     assert out.read_bytes() == b"an older video"
     assert sorted(os.listdir(tmp_path)) == ["sound.wav", "video.mp4"]
