@@ -17,7 +17,8 @@ import pandas as pd
 from numpy.typing import ArrayLike
 from scipy import stats
 
-from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults, Geometry
+from experiments.analysis.geometry import Geometry
+from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 
 STRATEGIES = ("hand", "tool", "vocal")
 # Toys at least this far from the arm's base count as "at distance 1" (paper, Fig. 4).

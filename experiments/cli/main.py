@@ -6,267 +6,27 @@ SIGTERM, each line saying what was kept and how to resume (experiments/cli/fault
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-from collections import Counter
-
-import numpy as np
 
 from experiments.batches.stored import stored_profiles
-from experiments.cli.args import (
-    RUN_DEFAULTS,
-    Parser,
-    UsageError,
-    iteration_list,
-    non_negative_int,
-    positive_int,
-    run_default,
+from experiments.cli.args import Parser, iteration_list, non_negative_int, positive_int, run_default
+from experiments.cli.commands import (
+    cmd_ablations,
+    cmd_batch,
+    cmd_bench,
+    cmd_compare,
+    cmd_eval,
+    cmd_random,
+    cmd_render,
+    cmd_report,
+    cmd_run,
+    cmd_say,
 )
 from experiments.cli.faults import run_command
 from learner.config import BABBLING_MODES
 from models.presets import PRESETS
 from sim.config import STICK_RETURNS
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
-
-
-def cmd_random(args: argparse.Namespace) -> None:
-    """Random arm commands in one backend, with a summary of what happened."""
-    from models.layout import ARM_DIM
-    from sim import Playroom
-
-    room = Playroom(grasp=args.grasp, seed=args.seed)
-    rng = np.random.default_rng(args.seed)
-    counts: Counter[str] = Counter()
-    print(f"{args.iterations} random arm commands, {args.grasp} grasping, seed {args.seed}")
-    for i in range(args.iterations):
-        feedback = room.act_arm(rng.uniform(-1.0, 1.0, ARM_DIM))
-        for e in feedback.events:
-            counts[f"{e.kind}" + (f" by {e.by}" if e.by else "")] += 1
-        if feedback.events:
-            said = ", ".join(
-                f"{e.kind}({e.obj or ''}{'' if e.by in (None, 'hand', 'stick') else ' ' + e.by})"
-                f"@{e.step}"
-                for e in feedback.events
-            )
-            print(f"  iteration {i:3d}: {said}")
-    print("  totals: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
-
-
-def cmd_run(args: argparse.Namespace) -> None:
-    """One trial of Model Babbling, written to a directory that survives being killed."""
-    from experiments import storage
-    from experiments.run.settings import TrialSettings, resume_settings
-    from experiments.run.trial import run_trial
-    from experiments.run.trial_files import TrialError
-
-    # Options left out are None: a new trial takes the documented defaults, a resumed one
-    # its own settings, which those given must match.
-    given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
-    try:
-        if args.resume:
-            settings = resume_settings(args.out, given)
-        else:
-            settings = TrialSettings(**{**RUN_DEFAULTS, **given})
-        trial = run_trial(
-            args.out,
-            settings,
-            resume=args.resume,
-            progress=not args.quiet,
-            notify=lambda line: print(f"playroom run: {line}", file=sys.stderr, flush=True),
-        )
-    except (TrialError, storage.CorruptFileError) as exc:
-        raise UsageError(str(exc)) from None
-    c = trial.counts
-    print(
-        f"{args.out}: {trial.iteration} iterations ({settings.grasp}, seed {settings.seed}); "
-        f"tool uses {c['tool_uses']}, words recognised {c['words_recognised']}, "
-        f"stick returns {c['stick_returns']}, diverged {c['diverged']}"
-    )
-
-
-def cmd_eval(args: argparse.Namespace) -> None:
-    """Competence, strategies and vocal accuracy of a trial's final state."""
-    from experiments import storage
-    from experiments.measure.evaluation import EvaluationSettings
-    from experiments.measure.trial_evaluation import evaluate_trial
-    from experiments.provenance import computed_on_line
-    from experiments.run.trial_files import TrialError
-
-    try:
-        summary = evaluate_trial(
-            args.dir, EvaluationSettings(n_placements=args.placements), progress=not args.quiet
-        )
-    except (TrialError, storage.CorruptFileError) as exc:
-        raise UsageError(str(exc)) from None
-    c, v = summary["competence"], summary["vocal"]
-    print(
-        f"{args.dir}: {summary['grasp']}, seed {summary['seed']}, "
-        f"{summary['evaluated_at_iteration']} iterations"
-    )
-    print(f"  {computed_on_line(args.dir)}")
-    print(
-        "  normalised competence (0 = random agent, 1 = perfect): "
-        + ", ".join(f"{k} {val:+.2f}" for k, val in c.items())
-    )
-    for ring, shares in summary["strategy_share"].items():
-        print(f"  strategies {ring}: " + ", ".join(f"{k} {v:.0%}" for k, v in shares.items()))
-    print(
-        f"  words below 0.4: {v['share_below_threshold']:.0%}; median best distance: names "
-        f"{v['median_names']:.2f}, distractors {v['median_distractors']:.2f}"
-    )
-    # The study pooled its runs per pixel before normalising: one trial has no such number.
-    print(
-        "  the study's tests: study-tests.parquet (its measure pools trials per pixel: "
-        "`playroom report` of the batch computes it, as the study computed it)"
-    )
-
-
-def cmd_batch(args: argparse.Namespace) -> None:
-    """Many trials on Dask, each run and evaluated; reruns skip what is complete."""
-    from experiments.batches.runner import run_batch
-    from experiments.batches.spec import BatchError, load_spec
-
-    try:
-        spec = load_spec(args.profile, args.config)
-        results = run_batch(spec, args.out, scheduler=args.scheduler, n_workers=args.workers)
-    except BatchError as exc:
-        raise UsageError(str(exc)) from None
-    for name, summary in sorted(results.items()):
-        c = summary["competence"]
-        print(f"  {name}: competence ring1 {c['ring1']:+.2f}, all {c['all']:+.2f}")
-    print(f"{args.out}: {len(spec.trials())} trials complete")
-
-
-def cmd_render(args: argparse.Namespace) -> None:
-    """An MP4 of a trial's iterations (replayed exactly), or of random commands."""
-    from experiments.video import gl
-
-    try:
-        gl.for_rendering()  # before anything imports mujoco
-    except gl.GLError as exc:
-        raise UsageError(str(exc)) from None
-    from experiments.video.encoding import RenderError
-    from experiments.video.episodes import render_random
-    from experiments.video.replay import ReplayError, render_trial
-    from sim.dmp import voice_trajectory
-    from sim.vocal.audio import synthesise
-    from sim.vocal.produce import synthesise_word
-
-    try:
-        if args.random:
-            if args.dir is not None:
-                raise UsageError("give either a trial directory or --random, not both")
-            count = len(args.iterations) if args.iterations else 4
-            path = render_random(
-                args.grasp, args.seed, args.out, iterations=count, size=args.size,
-                fps=args.fps, camera=args.camera,
-                voice_audio=lambda m: synthesise(voice_trajectory(m)),
-                word_audio=synthesise_word,
-            )  # fmt: skip
-            print(path)
-            return
-        if args.dir is None:
-            raise UsageError("give a trial directory, or --random")
-        path, replayed = render_trial(
-            args.dir, args.out, iterations=args.iterations, use_highlights=args.highlights,
-            size=args.size, fps=args.fps, camera=args.camera,
-        )  # fmt: skip
-    except (ValueError, RenderError, ReplayError) as exc:
-        raise UsageError(str(exc)) from None
-    for r in replayed:
-        verdict = "events as logged" if r.matches else "DIFFERS from the log"
-        print(f"  iteration {r.iteration}: replayed {verdict}")
-        if not r.matches:
-            diff = {k: (r.logged.get(k), v) for k, v in r.replayed.items() if r.logged.get(k) != v}
-            print(f"    logged vs replayed: {diff}")
-    print(path)
-
-
-def cmd_report(args: argparse.Namespace) -> None:
-    """Figures and report.html of a batch, its numbers beside the paper's."""
-    from experiments.analysis.results import ReportError
-    from experiments.report.batch_report import write_report
-
-    try:
-        print(write_report(args.dir, args.out, **_study_reference(args)))
-    except ReportError as exc:
-        raise UsageError(str(exc)) from None
-
-
-def cmd_compare(args: argparse.Namespace) -> None:
-    """Two batches (or one batch of both backends, given twice) side by side."""
-    from experiments.analysis.results import ReportError
-    from experiments.report.comparison import write_comparison
-
-    try:
-        print(
-            write_comparison(
-                args.dir_a,
-                args.dir_b,
-                args.out,
-                **_study_reference(args),
-            )
-        )
-    except ReportError as exc:
-        raise UsageError(str(exc)) from None
-
-
-def cmd_ablations(args: argparse.Namespace) -> None:
-    """Batches that change a setting or two, against a baseline batch, paired by seed."""
-    from experiments.analysis.results import ReportError
-    from experiments.report.ablations import write_ablations
-
-    try:
-        table = write_ablations(args.baseline, args.batches, args.out, **_study_reference(args))
-    except ReportError as exc:
-        raise UsageError(str(exc)) from None
-    print(table.read_text(), end="")
-    print(f"written: {table}, {table.with_name('ablations.csv').name}, ablations.png")
-
-
-def cmd_say(args: argparse.Namespace) -> None:
-    """A word as audio, from the voice parameters found to produce it."""
-    from pathlib import Path
-
-    from sim.vocal.audio import write_wav
-    from sim.vocal.config import DEFAULT_VOICE
-    from sim.vocal.produce import stored_distances, synthesise_word
-
-    if args.word not in DEFAULT_VOICE.words:
-        raise UsageError(f"unknown word {args.word!r}: one of {', '.join(DEFAULT_VOICE.words)}")
-    out = Path(args.out)
-    if not out.parent.is_dir() or not os.access(out.parent, os.W_OK):
-        raise UsageError(f"cannot write {out}: {out.parent} is not a writable directory")
-    waveform, rate = synthesise_word(args.word)
-    write_wav(out, waveform, rate)
-    distance = stored_distances()[args.word]
-    print(f"{out}: /{args.word}/, {len(waveform) / rate:.2f} s; its sound is {distance:.3f} from "
-          "the perfect word (recognised below 0.4)")  # fmt: skip
-
-
-def cmd_bench(args: argparse.Namespace) -> None:
-    from experiments.video import gl
-
-    sections = args.section or None
-    render_skipped = False
-    if sections is None or "render" in sections:
-        try:
-            gl.for_rendering()  # before anything imports mujoco
-        except gl.GLError as exc:
-            if sections is not None:
-                raise UsageError(str(exc)) from None
-            print(f"render: skipped ({exc})", flush=True)
-            render_skipped = True
-    else:
-        gl.without_rendering()
-    from experiments.bench.sections import SECTIONS, run_bench
-
-    unknown = [s for s in args.section if s not in SECTIONS]
-    if unknown:
-        raise UsageError(f"unknown bench section(s) {unknown}: choose from {sorted(SECTIONS)}")
-    if render_skipped:
-        sections = [s for s in SECTIONS if s != "render"]
-    run_bench(sections)
 
 
 def _study_reference_option(p: argparse.ArgumentParser) -> None:
@@ -277,16 +37,6 @@ def _study_reference_option(p: argparse.ArgumentParser) -> None:
         help="random commands per ring behind the study's own measure (default: the study's, "
         "10000 placements x 3 toys)",
     )
-
-
-def _study_reference(args: argparse.Namespace) -> dict:
-    """The room measures a report shows (measured here, by the measuring stage: a report
-    builds no room), with the reference size asked for, if any (the default is the study's,
-    experiments.analysis.study_summary)."""
-    from experiments.measure.for_reports import room_measures
-
-    n = args.study_reference_commands
-    return {"measures": room_measures() if n is None else room_measures(n)}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -359,6 +109,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("dir_a", help="a batch directory (e.g. the kinematic one)")
     p.add_argument("dir_b", help="another batch directory, or DIR_A again if it holds both")
     p.add_argument("--out", required=True, help="where to write comparison.html")
+    p.add_argument(
+        "--grasp-rate-commands",
+        type=positive_int,
+        metavar="N",
+        help="random arm commands played in each backend for the stick's grasp rates "
+        "(default: the comparison's own, which the page states)",
+    )
     _study_reference_option(p)
     p.set_defaults(func=cmd_compare)
 

@@ -29,7 +29,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from experiments import storage
-from experiments.analysis.results import BatchResults, Geometry, ReportError, check_out_dir, collect
+from experiments.analysis.geometry import Geometry
+from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import STRATEGIES, mann_whitney, paired_difference, vocal_summary
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE

@@ -13,7 +13,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments.analysis.results import Geometry, check_out_dir, collect
+from experiments.analysis.geometry import Geometry
+from experiments.analysis.results import check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import summarise_batch
 from experiments.file_names import REPORT_FILE

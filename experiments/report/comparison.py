@@ -15,10 +15,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import (
     COMPETENCE_SCOPES,
     BatchResults,
-    Geometry,
     ReportError,
     check_out_dir,
     collect,

@@ -19,7 +19,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 from matplotlib.ticker import MaxNLocator
 
-from experiments.analysis.results import BatchResults, Geometry
+from experiments.analysis.geometry import Geometry
+from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import STRATEGIES, competence_summary, curve_bands
 
 STRATEGY_COLOURS = {"hand": "tab:blue", "tool": "tab:orange", "vocal": "tab:green"}

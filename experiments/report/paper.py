@@ -16,7 +16,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from experiments.analysis.results import BatchResults, Geometry
+from experiments.analysis.geometry import Geometry
+from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import DISTANCE_ONE
 from experiments.analysis.study_summary import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
 from experiments.report.pages import Table, ci_text, num, p_value, pct, shares_text

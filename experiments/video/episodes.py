@@ -26,12 +26,7 @@ import numpy as np
 
 from experiments.video.encoding import FrameEncoder, mux_into_place
 from experiments.video.overlay import Caption, Overlay
-from experiments.video.recording import (
-    CAMERAS,
-    DEFAULT_SIZE,
-    FrameRecorder,
-    parse_size,
-)
+from experiments.video.recording import CAMERAS, DEFAULT_SIZE, FrameRecorder, parse_size
 from experiments.video.sound import AUDIO_RATE, Clip, write_track
 from models.layout import ARM_DIM, N_STEPS, VOICE_DIM
 from sim import Feedback, Playroom

@@ -71,7 +71,7 @@ def test_batch_report_and_compare_run_without_any_gl_library(no_gl_env, tmp_path
     assert report.returncode == 0, report.stderr
     compare = _playroom(
         no_gl_env, "compare", str(batch), str(batch), "--out", str(tmp_path / "cmp"), *few,
-        cwd=tmp_path,
+        "--grasp-rate-commands", "20", cwd=tmp_path,
     )  # fmt: skip
     assert compare.returncode == 0, compare.stderr
 
