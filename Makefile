@@ -123,7 +123,7 @@ bench: $(INSTALLED)
 
 ## voice-model: regenerate the vocal tract's articulators and fitted formant map (tens of minutes)
 voice-model: $(INSTALLED)
-	$(BIN)/python -m sim.vocal.fit_voice_model
+	$(BIN)/python -m sim.vocal.fitting.fit_voice_model
 
 clean:
 	rm -rf $(VENV) .lock-venv .pytest_cache .ruff_cache .mypy_cache

@@ -45,6 +45,8 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
     assert "models/playroom.xml" in names
     assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
     assert "experiments/batches/profiles/demo.json" in names
+    # The voice's build-time fitting script is not installed (pyproject.toml excludes it).
+    assert not [n for n in names if n.startswith("sim/vocal/fitting")]
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
     for tool in ("pytest", "pytest-xdist", "ruff", "mypy"):
         (line,) = [r for r in requires if re.split(r"[<>=!~; \[]", r.split()[1])[0] == tool]

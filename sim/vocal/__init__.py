@@ -11,5 +11,6 @@ Modules, one concept each:
 - `tract`: `VocalTract`, VocalTractLab's tract, the study's ("vtl").
 - `registry`: the tracts by name, and `make_tract`.
 - `audio`: waveform synthesis with VTL and WAV writing.
-- `fit_voice_model`: the script that regenerates the data files in `data/`.
+- `fitting/fit_voice_model`: the build-time script that regenerates the data files in `data/`
+  (not installed with the package).
 """

@@ -109,6 +109,6 @@ def default_formant_map() -> FormantMap:
     """The stored fast map (data/formant_map.npz, written by fit_voice_model)."""
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
         )
     return FormantMap.load(DATA_FILE)

@@ -95,7 +95,7 @@ def save_productions(words: tuple[str, ...], params: np.ndarray, distances: np.n
 def _stored() -> dict[str, tuple[np.ndarray, float]]:
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
         )
     with np.load(DATA_FILE) as d:
         return {

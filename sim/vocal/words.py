@@ -46,7 +46,7 @@ def vowel_targets(config: VoiceConfig = DEFAULT_VOICE) -> dict[str, np.ndarray]:
     """Stored vowel targets: vowel name -> (2,) log2 Hz (F1, F2)."""
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
         )
     with np.load(DATA_FILE) as d:
         stored = dict(zip((str(v) for v in d["vowels"]), d["log2_hz"], strict=True))

@@ -1,6 +1,7 @@
 """Regenerate the voice's data files in sim/vocal/data/ (seeded; `make voice-model`).
 
-    python -m sim.vocal.fit_voice_model [--samples N] [--seed S] [--workers W] [--max-iter I]
+    python -m sim.vocal.fitting.fit_voice_model [--samples N] [--seed S] [--workers W]
+        [--max-iter I]
 
 1. articulators.npz: PCA articulators of the VTL speaker; prints the explained variance.
 2. vowels.npz: vowel targets (exact path on the speaker's vowel shapes), printed beside the
