@@ -14,12 +14,12 @@ import os
 from pathlib import Path
 
 from experiments.analysis.geometry import Geometry
-from experiments.analysis.results import check_out_dir, collect
+from experiments.analysis.results import BatchResults, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import summarise_batch
 from experiments.file_names import REPORT_FILE
 from experiments.report import name_strategies, paper
-from experiments.report.figures import report_figures
+from experiments.report.figures import FigureFile, report_figures
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
 
@@ -37,12 +37,7 @@ def write_report(
     results = collect(batch_dir)
     out = Path(out_dir) if out_dir is not None else results.batch_dir
     check_out_dir(out)
-    geometry = Geometry.of(results)
-    numbers = summarise_batch(results, geometry)
-    numbers["study"] = measures.study_numbers(results)
-    published = paper.published()
-    figures = report_figures(results, geometry, published["competence_all"].value)
-    figures += study_figure_files(results, published)
+    geometry, numbers, published, figures = numbers_and_figures(results, measures)
     where, where_note = where_table(results)
     page = render(
         "report.html.j2",
@@ -61,3 +56,18 @@ def write_report(
         **name_strategies.page_context(results, geometry.threshold),
     )
     return write_page(out, figures, REPORT_FILE, page)
+
+
+def numbers_and_figures(
+    results: BatchResults, measures: RoomMeasures
+) -> tuple[Geometry, dict, dict[str, paper.PaperNumber], list[FigureFile]]:
+    """What every page of results shows: its geometry, its numbers (the study's among them,
+    from `measures`), the paper's published numbers and the figures (the study's Fig. 4
+    included)."""
+    geometry = Geometry.of(results)
+    numbers = summarise_batch(results, geometry)
+    numbers["study"] = measures.study_numbers(results)
+    published = paper.published()
+    figures = report_figures(results, geometry, published["competence_all"].value)
+    figures += study_figure_files(results, published)
+    return geometry, numbers, published, figures

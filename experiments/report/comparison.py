@@ -33,12 +33,12 @@ from experiments.analysis.stats import (
     regions,
     strategy_counts,
     strategy_table,
-    summarise_batch,
     welch,
 )
 from experiments.file_names import COMPARISON_FILE
 from experiments.report import name_strategies, paper
-from experiments.report.figures import FigureFile, report_figures
+from experiments.report.batch_report import numbers_and_figures
+from experiments.report.figures import FigureFile
 from experiments.report.pages import (
     Table,
     ci_text,
@@ -52,7 +52,6 @@ from experiments.report.pages import (
     where_table,
     write_page,
 )
-from experiments.report.study_figures import study_figure_files
 
 # Random arm commands behind the comparison's stick-grasp rates of the two backends.
 GRASP_RATE_COMMANDS = 1000
@@ -271,15 +270,8 @@ def write_comparison(
     a, b = _sides(dir_a, dir_b)
     check_out_dir(Path(out_dir))
     merged = a.merge(b)
-    geometry = Geometry.of(merged)
-    numbers = summarise_batch(merged, geometry)
-    numbers["study"] = measures.study_numbers(merged)
-    published = paper.published()
-    figures = [
-        FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png)
-        for f in report_figures(merged, geometry, published["competence_all"].value)
-        + study_figure_files(merged, published)
-    ]
+    geometry, numbers, published, page_figures = numbers_and_figures(merged, measures)
+    figures = [FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png) for f in page_figures]
     g = merged.groups
     where, where_note = where_table(merged)
     page = render(

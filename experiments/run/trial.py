@@ -58,6 +58,7 @@ class Trial:
         self.dir = Path(out_dir)
         self.settings = settings
         self.config = full_config(settings)
+        self.identity = trial_identity(self.config)  # carried by every checkpoint
         self.notices: list[str] = []  # one line each: what a resume had to do
         self._refuse_foreign_path()
         try:
@@ -119,9 +120,7 @@ class Trial:
                 )
         try:
             (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
-            probe = d / ".write-test"
-            probe.write_bytes(b"")
-            probe.unlink()
+            storage.check_writable(d)
         except OSError as exc:
             raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
         if not config_path.exists():
@@ -151,7 +150,7 @@ class Trial:
             "room": room_state,
             "counts": self.counts,
             # Whose checkpoint it is: one copied into another trial is refused there.
-            "identity": trial_identity(self.config),
+            "identity": self.identity,
         }
         newest = self.dir / CHECKPOINT_FILE
         if newest.exists():

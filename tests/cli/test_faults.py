@@ -143,17 +143,17 @@ def test_disk_full_during_eval_leaves_the_evaluation_as_it_was(
 @pytest.fixture
 def light_figures(monkeypatch):
     """Reports draw two tiny figures instead of their real ones (tests/report/test_report.py checks
-    those): what is checked here is how the files are written."""
-    from experiments.report import batch_report, comparison
+    those): what is checked here is how the files are written. Both pages draw them through
+    `batch_report.numbers_and_figures`."""
+    from experiments.report import batch_report
 
     def figures(*args, **kwargs):
         return [
             FigureFile(f"fig{i}.png", "a figure", "its caption", PNG + bytes(i)) for i in (1, 2)
         ]
 
-    for module in (batch_report, comparison):
-        monkeypatch.setattr(module, "report_figures", figures)
-        monkeypatch.setattr(module, "study_figure_files", lambda *args: [])
+    monkeypatch.setattr(batch_report, "report_figures", figures)
+    monkeypatch.setattr(batch_report, "study_figure_files", lambda *args: [])
 
 
 def test_disk_full_during_a_report_leaves_nothing_and_keeps_the_old_one(
