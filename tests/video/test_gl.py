@@ -44,6 +44,9 @@ def test_fake_gl_really_breaks_rendering_imports(no_gl_env, tmp_path):
     assert result.returncode != 0 and b"no GL library" in result.stderr
 
 
+# About 20 s (a local cluster and three fresh interpreters): `make test-slow` runs it; the quick
+# suite keeps the import checks below and tests/test_layers.py.
+@pytest.mark.slow
 def test_batch_report_and_compare_run_without_any_gl_library(no_gl_env, tmp_path):
     config = tmp_path / "tiny.json"
     config.write_text(
