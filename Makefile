@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate comparison ablations clean
+.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison ablations clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -61,6 +61,12 @@ video: $(INSTALLED)
 replicate: $(INSTALLED)
 	$(BIN)/playroom batch --profile replication --out $(OUT)/replication
 	$(BIN)/playroom report $(OUT)/replication
+
+## replicate-diva: the replication with the study's vocal tract, DIVA (the replication-diva
+## profile); needs DIVA's data installed once: `$(BIN)/playroom voice-data diva PATH`
+replicate-diva: $(INSTALLED)
+	$(BIN)/playroom batch --profile replication-diva --out $(OUT)/replication-diva
+	$(BIN)/playroom report $(OUT)/replication-diva
 
 ## comparison: both backends at the study's scale per trial (the comparison profile: 16 seeds x
 ## 80000 each, study preset) and their comparison page; about an hour on 2 cores, resumes

@@ -20,7 +20,6 @@ from sim.grasping.base import GraspBackend
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import VoiceConfig
 from sim.vocal.voice import Voice
-from sim.vocal.words import word_features
 
 
 @dataclass(frozen=True)
@@ -80,7 +79,7 @@ class Caregiver:
             word, obj = self.words.names[TOYS.index(held)], held
         else:
             word, obj = self.words.distractors[rng.integers(len(self.words.distractors))], None
-        features = word_features(word, config=self.vocal_tract.config)
+        features = self.vocal_tract.word_features(word)
         return features, ev.Event(ev.CAREGIVER_SAID, N_STEPS, obj=obj, word=word)
 
     def hear(self, physics: PlayroomPhysics, voice_formants: np.ndarray) -> list[ev.Event]:

@@ -22,6 +22,7 @@ from models.checks import (
     tuples,
 )
 from models.presets import PRESETS
+from models.tracts import DEFAULT_TRACT, TRACTS
 
 # The allowed values of the world's choices. sim/dmp.py and sim/experimenter.py, which apply
 # them, import them from here, so that a config is checked without importing either.
@@ -58,6 +59,10 @@ class WorldConfig:
     # The experimenter returns a stick beyond the hand's reach to its start pose between
     # iterations ("out_of_reach"), or never, as in the study (sim/experimenter.py, §11).
     stick_return: str = "out_of_reach"
+    # The vocal tract (sim/vocal/registry.py): "vtl", VocalTractLab, this project's; or "diva",
+    # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
+    # D13).
+    voice: str = DEFAULT_TRACT
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a
@@ -79,6 +84,7 @@ class WorldConfig:
         check_choice(w + "catch_rule", self.catch_rule, CATCH_RULES)
         check_number(w + "caregiver_bring_rate", self.caregiver_bring_rate, "(0, 1]")
         check_choice(w + "stick_return", self.stick_return, STICK_RETURNS)
+        check_choice(w + "voice", self.voice, TRACTS)
 
     @property
     def arm_length(self) -> float:

@@ -34,7 +34,7 @@ from sim.model_edits import ModelEdits
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 from sim.task import ARM, VOICE, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.registry import DEFAULT_TRACT, make_tract
+from sim.vocal.registry import make_tract
 
 # Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
 RANGE_TOLERANCE = 1e-9
@@ -48,7 +48,7 @@ class Playroom:
     seed: seeds every random choice of the world (placements, the caregiver's words).
     config, voice: the world's and the voice's numbers (config: the default preset's world,
     `world_preset(DEFAULT_PRESET)`, when None); the MJCF model is checked against `config`
-    when it loads. The vocal tract is the default one (sim/vocal/registry.py).
+    when it loads. The vocal tract is the one `config.voice` names (sim/vocal/registry.py).
     exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
     a frame) instead of the fitted formant map (microseconds); for audio checks.
     """
@@ -69,7 +69,7 @@ class Playroom:
         self.seed = int(seed)
         self.config = config
         self.rng = np.random.default_rng(self.seed)
-        self.vocal_tract = make_tract(DEFAULT_TRACT, exact_voice, voice, config)
+        self.vocal_tract = make_tract(config.voice, exact_voice, voice, config)
         self.physics: PlayroomPhysics = backend.physics_class.load(config)
         self.backend = backend(config, ModelEdits(self.physics))
         self.caregiver = Caregiver(self.backend, config, self.vocal_tract, self.rng)

@@ -24,6 +24,7 @@ import pandas as pd
 from experiments import storage
 from experiments.analysis.curves import curve_rows, tool_numbers
 from experiments.analysis.logs import read_log
+from experiments.config_file import with_added_settings
 from experiments.file_names import (
     COMPETENCE_FILE,
     CONFIG_FILE,
@@ -321,6 +322,7 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
     batch_dir = Path(batch_dir)
     dirs = _trial_dirs(batch_dir)
     configs = [_read_json(d / CONFIG_FILE) for d in dirs]
+    configs = [with_added_settings(c) if isinstance(c, dict) else c for c in configs]
     evals = [_read_json(d / EVAL_FILE) for d in dirs]
     for d, config in zip(dirs, configs, strict=True):
         if not isinstance(config, dict) or not {"grasp", "babbling", "seed", "iterations"} <= set(

@@ -18,6 +18,7 @@ from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig
 from models.presets import DEFAULT_PRESET, PRESETS
+from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS, WorldConfig
 from sim.grasping.names import GRASPS
 
@@ -36,6 +37,7 @@ FIELD_RULES = {
     "eval_placements": "a positive integer (placements per ring)",
     "stick_return": f"one of {', '.join(STICK_RETURNS)}",
     "preset": f"one of {', '.join(PRESETS)}",
+    "voice": f"one of {', '.join(TRACTS)}",
     "overrides": 'an object {"world": {...}, "learner": {...}}',
     "description": "a string",
 }
@@ -64,6 +66,7 @@ class BatchSpec:
     eval_placements: int = 100
     stick_return: str = WorldConfig.stick_return
     preset: str = DEFAULT_PRESET
+    voice: str = DEFAULT_TRACT
     overrides: dict = field(default_factory=dict)
     description: str = field(default="", compare=False)
 
@@ -92,6 +95,8 @@ class BatchSpec:
             raise _field_error("stick_return", self.stick_return)
         if self.preset not in PRESETS:
             raise _field_error("preset", self.preset)
+        if self.voice not in TRACTS:
+            raise _field_error("voice", self.voice)
         if not isinstance(self.overrides, dict) or not all(
             k in ("world", "learner") and isinstance(v, dict) for k, v in self.overrides.items()
         ):
@@ -114,6 +119,7 @@ class BatchSpec:
                         checkpoint_every=min(self.checkpoint_every, self.iterations),
                         stick_return=self.stick_return,
                         preset=self.preset,
+                        voice=self.voice,
                         overrides=self.overrides,
                     )
                     out.append((name, settings))

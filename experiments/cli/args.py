@@ -7,6 +7,7 @@ from typing import Any, NoReturn
 
 from learner.config import LearnerConfig
 from models.presets import DEFAULT_PRESET
+from models.tracts import DEFAULT_TRACT
 from sim.config import DEFAULT_WORLD
 from sim.grasping.names import DEFAULT_GRASP
 
@@ -20,6 +21,7 @@ RUN_DEFAULTS: dict[str, Any] = {
     "checkpoint_every": 1000,
     "stick_return": DEFAULT_WORLD.stick_return,
     "preset": DEFAULT_PRESET,
+    "voice": DEFAULT_TRACT,
 }
 
 

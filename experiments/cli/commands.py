@@ -132,9 +132,6 @@ def cmd_render(args: argparse.Namespace) -> None:
     from experiments.video.encoding import RenderError
     from experiments.video.episodes import render_random
     from experiments.video.replay import ReplayError, render_trial
-    from sim.dmp import voice_trajectory
-    from sim.vocal.audio import synthesise
-    from sim.vocal.produce import synthesise_word
 
     try:
         if args.random:
@@ -143,9 +140,7 @@ def cmd_render(args: argparse.Namespace) -> None:
             count = len(args.iterations) if args.iterations else 4
             path = render_random(
                 args.grasp, args.seed, args.out, iterations=count, size=args.size,
-                fps=args.fps, camera=args.camera,
-                voice_audio=lambda m: synthesise(voice_trajectory(m)),
-                word_audio=synthesise_word,
+                fps=args.fps, camera=args.camera, voice=args.voice, sound=True,
             )  # fmt: skip
             print(path)
             return
@@ -215,7 +210,7 @@ def cmd_say(args: argparse.Namespace) -> None:
 
     from sim.vocal.audio import write_wav
     from sim.vocal.config import DEFAULT_VOICE
-    from sim.vocal.produce import stored_distances, synthesise_word
+    from sim.vocal.productions import stored_distances, synthesise_word
 
     if args.word not in DEFAULT_VOICE.words:
         raise UsageError(f"unknown word {args.word!r}: one of {', '.join(DEFAULT_VOICE.words)}")
@@ -268,3 +263,27 @@ def _study_reference(args: argparse.Namespace) -> dict:
 
     n = args.study_reference_commands
     return {"measures": room_measures() if n is None else room_measures(n)}
+
+
+def cmd_voice_data(args: argparse.Namespace) -> None:
+    """Check the user's DIVA file and install its map, or say what is installed."""
+    from sim.vocal.diva.data import (
+        DivaDataError,
+        DivaDataMissing,
+        cache_path,
+        install,
+        installed_fit,
+    )
+
+    if args.path is None:
+        try:
+            installed_fit()
+        except (DivaDataMissing, DivaDataError) as exc:
+            raise UsageError(str(exc)) from None
+        print(f"DIVA's map (the study's) is installed in {cache_path()}")
+        return
+    try:
+        where, what = install(args.path)
+    except DivaDataError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"{args.path}: {what}; its map is installed in {where} (`--voice diva` uses it)")

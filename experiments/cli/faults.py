@@ -25,6 +25,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from experiments.cli.args import UsageError
+from sim.vocal.diva.data import DivaDataMissing
 
 EXIT_FAULT = 1
 EXIT_USAGE = 2
@@ -158,7 +159,7 @@ def run_command(args: argparse.Namespace, argv: list[str]) -> int:
     with signals_as_exceptions():
         try:
             args.func(args)
-        except UsageError as exc:
+        except (UsageError, DivaDataMissing) as exc:  # DIVA's data is the user's to install
             print(f"{prefix} error: {exc}", file=sys.stderr)
             return EXIT_USAGE
         except OSError as exc:

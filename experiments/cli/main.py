@@ -21,10 +21,12 @@ from experiments.cli.commands import (
     cmd_report,
     cmd_run,
     cmd_say,
+    cmd_voice_data,
 )
 from experiments.cli.faults import run_command
 from learner.config import BABBLING_MODES
 from models.presets import PRESETS
+from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
 
@@ -36,6 +38,16 @@ def _study_reference_option(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="random commands per ring behind the study's own measure (default: the study's, "
         "10000 placements x 3 toys)",
+    )
+
+
+def _voice_option(p: argparse.ArgumentParser, which: str, default: str | None = None) -> None:
+    p.add_argument(
+        "--voice",
+        choices=TRACTS,
+        default=default,
+        help="the vocal tract: VocalTractLab (vtl) or the study's DIVA map (diva; its data "
+        f"installed once with `playroom voice-data diva PATH`); {which}",
     )
 
 
@@ -78,6 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="world and learner as the study's code behaved, or the project's earlier choices "
         "(docs/protocol.md §11); " + run_default("preset"),
     )
+    _voice_option(p, run_default("voice"))
     p.add_argument(
         "--resume", action="store_true", help="continue the trial in --out as configured"
     )
@@ -138,7 +151,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--size", default="640x480", help="WxH, even numbers")
     p.add_argument("--fps", type=float, default=50.0)
     p.add_argument("--camera", choices=["top", "hand_view"], default="top")
+    _voice_option(
+        p, f"with --random (a trial's is its own); default: {DEFAULT_TRACT}", default=DEFAULT_TRACT
+    )
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("voice-data", help="install the data a vocal tract needs (DIVA's map)")
+    p.add_argument("tract", choices=["diva"], help="the tract whose data it is")
+    p.add_argument(
+        "path",
+        nargs="?",
+        help="DIVA's diva_synth.mat (or divapy's fmfit_py.mat); left out: say what is installed",
+    )
+    p.set_defaults(func=cmd_voice_data)
 
     p = sub.add_parser("say", help="write a word as audio (WAV), from the agent's voice")
     p.add_argument("word", help="one of the 6 words, e.g. oey")

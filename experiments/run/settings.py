@@ -22,10 +22,12 @@ from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
 from models.presets import DEFAULT_PRESET, PRESETS
+from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS, WorldConfig, world_preset
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
+from sim.vocal.diva.data import DivaDataError, DivaDataMissing, installed_fit
 
 
 @dataclass(frozen=True)
@@ -41,6 +43,9 @@ class TrialSettings:
     # "study": the world and learner as the study's code behaved; "project": this project's
     # earlier choices (sim.config.world_preset, learner.config.learner_preset).
     preset: str = DEFAULT_PRESET
+    # The vocal tract (models/tracts.py): "vtl" (VocalTractLab) or "diva" (the study's DIVA
+    # map, from the user's installed data: `playroom voice-data diva PATH`).
+    voice: str = DEFAULT_TRACT
     # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
     # departure switched at a time (ablations, docs/replication.md).
     overrides: dict = dataclasses.field(default_factory=dict)
@@ -50,6 +55,8 @@ class TrialSettings:
             raise TrialError(f"unknown grasp {self.grasp!r}: one of {', '.join(GRASPS)}")
         if self.preset not in PRESETS:
             raise TrialError(f"unknown preset {self.preset!r}: one of {', '.join(PRESETS)}")
+        if self.voice not in TRACTS:
+            raise TrialError(f"unknown voice {self.voice!r}: one of {', '.join(TRACTS)}")
         if self.babbling not in BABBLING_MODES:
             raise TrialError(
                 f"unknown babbling {self.babbling!r}: one of {', '.join(BABBLING_MODES)}"
@@ -69,7 +76,10 @@ class TrialSettings:
 
 # Override sections, their configs, and the fields a trial setting owns: an override of one
 # would make config.json's "trial" section say something else than the world or learner does.
-OVERRIDABLE = {"world": (WorldConfig, "stick_return"), "learner": (LearnerConfig, "babbling")}
+OVERRIDABLE = {
+    "world": (WorldConfig, ("stick_return", "voice")),
+    "learner": (LearnerConfig, ("babbling",)),
+}
 
 
 def _check_overrides(overrides: object) -> None:
@@ -85,11 +95,12 @@ def _check_overrides(overrides: object) -> None:
         cls, owned = OVERRIDABLE[section]
         if not isinstance(values, dict):
             raise TrialError(f"overrides.{section} must be an object of settings, got {values!r}")
-        known = {f.name for f in dataclasses.fields(cls)} - {owned}
+        known = {f.name for f in dataclasses.fields(cls)} - set(owned)
         unknown = sorted(set(values) - known)
-        if owned in values:
+        taken = sorted(set(owned) & set(values))
+        if taken:
             raise TrialError(
-                f"overrides.{section}.{owned} is the trial setting {owned}: set that instead"
+                f"overrides.{section}.{taken[0]} is the trial setting {taken[0]}: set that instead"
             )
         if unknown:
             raise TrialError(
@@ -113,13 +124,24 @@ def full_config(
             settings.preset, **{"babbling": settings.babbling, **changes.get("learner", {})}
         )
         world = world or world_preset(
-            settings.preset, **{"stick_return": settings.stick_return, **changes.get("world", {})}
+            settings.preset,
+            **{
+                "stick_return": settings.stick_return,
+                "voice": settings.voice,
+                **changes.get("world", {}),
+            },
         )
         # The MJCF's lengths must equal the world's (sim/physics.py): refused now rather than
         # when the room is built, after config.json is written. A load costs milliseconds.
         PlayroomPhysics.load(world)
     except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
         raise TrialError(f"overrides do not fit the configs: {exc}") from None
+    if world.voice == "diva":
+        # Its data is the user's: checked before anything is written, never replaced by VTL.
+        try:
+            installed_fit()
+        except (DivaDataMissing, DivaDataError) as exc:
+            raise TrialError(str(exc)) from None
     config = {
         "trial": dataclasses.asdict(settings),
         "world": dataclasses.asdict(world),

@@ -25,6 +25,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import provenance, storage
+from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
@@ -47,7 +48,6 @@ from experiments.run.trial_files import (
     trial_identity,
 )
 from models.layout import TOYS, block_slice
-from sim.vocal.words import word_distances
 
 
 class Trial:
@@ -109,7 +109,7 @@ class Trial:
             diff = [
                 f"{key}: {a!r} != {b!r}"
                 for key, a, b in storage.config_differences(
-                    storage.read_json(config_path), self.config
+                    with_added_settings(storage.read_json(config_path)), self.config
                 )
                 if key not in EXTENSIBLE
             ]
@@ -245,7 +245,7 @@ class Trial:
         proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
             sound = feedback.s[block_slice("sound")]
-            distances = word_distances(sound, self.room.vocal_tract.config)
+            distances = self.room.vocal_tract.word_distances(sound)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
         row = log_row(self.iteration, proposal, feedback, context)
         self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)

@@ -15,6 +15,7 @@ import re
 from pathlib import Path
 
 from experiments import storage
+from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
@@ -69,7 +70,7 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
         raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
     if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
         raise TrialError(f"{trial_dir} has no checkpoint yet")
-    config = storage.read_json(trial_dir / CONFIG_FILE)
+    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
     agent, room, meta, fallback = restore_newest(trial_dir, config)
     if fallback is not None:
         # Only the resume may fall back: it rewrites the logs past the previous checkpoint.

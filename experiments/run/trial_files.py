@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from experiments import storage
+from experiments.config_file import identity_form
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
 from learner.agent import Agent
 from learner.config import LearnerConfig
@@ -125,7 +126,7 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
 def trial_identity(config: dict) -> dict:
     """What a checkpoint carries of its trial (in its metadata): the seed, and a hash of the
     trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
-    kept = json.loads(json.dumps(config))  # a deep copy
+    kept = identity_form(config)  # a copy, as older trials' configs would read
     for key in _NOT_IDENTITY:
         *parents, last = key.split(".")
         node = kept

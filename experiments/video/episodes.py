@@ -29,8 +29,11 @@ from experiments.video.overlay import Caption, Overlay
 from experiments.video.recording import CAMERAS, DEFAULT_SIZE, FrameRecorder, parse_size
 from experiments.video.sound import AUDIO_RATE, Clip, write_track
 from models.layout import ARM_DIM, N_STEPS, VOICE_DIM
+from models.presets import DEFAULT_PRESET
+from models.tracts import DEFAULT_TRACT
 from sim import Feedback, Playroom
 from sim import events as ev
+from sim.config import world_preset
 
 # 50 frames per second shows one 50-step movement in 1 s, which is also its simulated time
 # (20 ms control steps).
@@ -103,6 +106,9 @@ class EpisodeRenderer:
         self.audio_rate = int(audio_rate)
         self.shadows = shadows
         self.clips: list[Clip] = []
+        # What the sound track is, shown on every frame once a film adds sound (set by
+        # `film_iteration` from the room's vocal tract).
+        self.sound_label: str | None = None
         self._recorder: FrameRecorder | None = None
         self._overlay: Overlay | None = None
         self._model: mujoco.MjModel | None = None
@@ -146,6 +152,7 @@ class EpisodeRenderer:
             model,
             None if goal is None else np.asarray(goal, dtype=float),
             goal_block,
+            self.sound_label,
         )
         for _ in range(self.lead_frames):
             recorder.capture()
@@ -234,21 +241,26 @@ def render_random(
     lead_frames: int = LEAD_FRAMES,
     hold_frames: int = HOLD_FRAMES,
     shadows: bool = False,
+    voice: str = DEFAULT_TRACT,
+    sound: bool = False,
 ) -> Path:
     """Film `iterations` random commands (half arm, half voice, in a seeded random order) in a
     new room and write the MP4 with overlay and sound to `out_path`.
 
     voice_audio(m (28,)) -> (waveform, rate Hz): the agent's sound of a voice command, placed at
     the movement's start; word_audio(word) -> (waveform, rate Hz): the caregiver's word, placed
-    at the step she says it. None: silent. shadows: see `FrameRecorder`. Every argument is
-    checked before anything renders.
+    at the step she says it. None: silent, unless `sound`, which takes both from the room's
+    vocal tract. voice: the tract (models/tracts.py). shadows: see `FrameRecorder`. Every
+    argument is checked before anything renders.
     """
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations <= 0:
         raise ValueError(f"iterations must be a positive integer, got {iterations!r}")
     size, fps = parse_size(size), _check_fps(fps)
     _check_camera(camera)
     out = check_output_path(out_path)
-    room = Playroom(grasp=grasp, seed=seed)
+    room = Playroom(grasp=grasp, seed=seed, config=world_preset(DEFAULT_PRESET, voice=voice))
+    if sound:
+        voice_audio, word_audio = tract_audio(room)
     rng = np.random.default_rng([seed, 1])  # a stream apart from the room's own
     spaces = ["arm"] * math.ceil(iterations / 2) + ["voice"] * (iterations // 2)
     spaces = [spaces[k] for k in rng.permutation(iterations)]
@@ -257,6 +269,14 @@ def render_random(
             m = rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM)
             film_iteration(renderer, room, space, m, voice_audio, word_audio, model="random")
         return renderer.write(out)
+
+
+def tract_audio(
+    room: Playroom,
+) -> tuple[Callable[[np.ndarray], tuple[np.ndarray, int]], Callable[[str], tuple[np.ndarray, int]]]:
+    """(voice_audio, word_audio) of the room's vocal tract, for `film_iteration`."""
+    tract = room.vocal_tract
+    return (lambda m: tract.audio(tract.trajectory(m))), tract.word_audio
 
 
 def film_iteration(
@@ -271,6 +291,8 @@ def film_iteration(
     """Film one command with its sounds: the agent's voice from the movement's start, the
     caregiver's word at the step she says it. `overlay` goes to `render_iteration`."""
     clips: list[Clip] = []
+    if voice_audio is not None or word_audio is not None:
+        renderer.sound_label = room.vocal_tract.sound_label
     if motor_space == "voice" and voice_audio is not None:
         clips.append((0.0, *voice_audio(m)))
     before = renderer.n_frames

@@ -134,6 +134,7 @@ class Caption:
     model: str | None = None
     goal: np.ndarray | None = None
     goal_block: str | None = None
+    sound: str | None = None  # what the sound track is (the tract's `sound_label`)
 
     @property
     def goal_is_position(self) -> bool:
@@ -240,6 +241,7 @@ class Overlay:
             f"iteration {caption.iteration}  {caption.motor_space}  {step_text}",
             f"model: {caption.model or 'none'}",
             describe_goal(caption),
+            *([caption.sound] if caption.sound else []),
         ]
         self._text_box(pen, lines, [DEFAULT_EVENT_COLOUR] * len(lines), top=True)
         if shown:

@@ -18,16 +18,19 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.analysis.logs import read_log
+from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import fresh_trial_parts, log_row
-from experiments.video.episodes import EpisodeRenderer, check_output_path, film_iteration
+from experiments.video.episodes import (
+    EpisodeRenderer,
+    check_output_path,
+    film_iteration,
+    tract_audio,
+)
 from experiments.video.recording import parse_size
 from learner.agent import Proposal
 from models.layout import MODELS, TOYS
 from models.world import Feedback
-from sim.dmp import voice_trajectory
-from sim.vocal.audio import synthesise
-from sim.vocal.produce import synthesise_word
 
 
 class ReplayError(Exception):
@@ -108,8 +111,9 @@ def render_trial(
             raise ReplayError(
                 f"iterations {bad} are out of range: the trial logged 0..{len(log) - 1}"
             )
-    config = storage.read_json(trial_dir / CONFIG_FILE)
+    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
     agent, room = fresh_trial_parts(config)
+    voice_audio, word_audio = tract_audio(room)
     logged_rows = log.set_index("iteration")
     results: list[ReplayedIteration] = []
     bar = tqdm(total=wanted[-1] + 1, disable=not progress, desc="replay", unit="it")
@@ -123,8 +127,8 @@ def render_trial(
                         room,
                         proposal.motor_space,
                         proposal.m,
-                        voice_audio=lambda m: synthesise(voice_trajectory(m)),
-                        word_audio=synthesise_word,
+                        voice_audio=voice_audio,
+                        word_audio=word_audio,
                         model=None if proposal.model is None else f"{proposal.model + 1}",
                         goal=proposal.goal,
                         goal_block=_goal_block(proposal.model),

@@ -9,25 +9,21 @@ the fast formant map) come as close as possible to the word's perfect features:
 2. L-BFGS-B (bounds [-1, 1]) on the squared feature distance, from that guess and from
    perturbed copies of it; the best result wins.
 
-`fit_voice_model` stores the results in data/productions.npz; `compute_productions` redoes it.
+`fit_voice_model` stores the results in data/productions.npz (read by `sim.vocal.productions`);
+`compute_productions` redoes it.
 """
 
 from __future__ import annotations
-
-import functools
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import lsq_linear, minimize
 
 from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.dmp import rollout, voice_trajectory
-from sim.vocal.audio import DEFAULT_DURATION_S, DEFAULT_PAD_S, synthesise
+from sim.dmp import rollout
+from sim.vocal.productions import DATA_FILE
 from sim.vocal.tract import VocalTract
-from sim.vocal.words import word_features
 
-DATA_FILE = Path(__file__).parent / "data" / "productions.npz"
 N_STARTS = 8  # optimisation starts per word: the linear guess and 7 perturbations of it
 START_NOISE = 0.2  # std of the perturbations, in parameter units
 
@@ -55,7 +51,7 @@ def find_word_params(
     word: str, tract: VocalTract, n_starts: int = N_STARTS, seed: int = 0
 ) -> tuple[np.ndarray, float]:
     """Best (28,) voice parameters for a word and their feature distance to it (10D)."""
-    target = word_features(word, config=tract.config)
+    target = tract.word_features(word)
     rng = np.random.default_rng(seed)
 
     def loss(m: np.ndarray) -> float:
@@ -89,37 +85,3 @@ def compute_productions(
 def save_productions(words: tuple[str, ...], params: np.ndarray, distances: np.ndarray) -> None:
     DATA_FILE.parent.mkdir(parents=True, exist_ok=True)
     np.savez(DATA_FILE, words=np.array(words), params=params, distances=distances)
-
-
-@functools.cache
-def _stored() -> dict[str, tuple[np.ndarray, float]]:
-    if not DATA_FILE.exists():
-        raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
-        )
-    with np.load(DATA_FILE) as d:
-        return {
-            str(w): (p, float(dist))
-            for w, p, dist in zip(d["words"], d["params"], d["distances"], strict=True)
-        }
-
-
-def say(word: str) -> np.ndarray:
-    """(28,) stored voice parameters that produce the word (a copy)."""
-    stored = _stored()
-    if word not in stored:
-        raise ValueError(f"unknown word {word!r}; expected one of {tuple(stored)}")
-    return stored[word][0].copy()
-
-
-def stored_distances() -> dict[str, float]:
-    """Word -> feature distance of its stored production (fast map, at fit time)."""
-    return {w: d for w, (_, d) in _stored().items()}
-
-
-def synthesise_word(
-    word: str, duration_s: float = DEFAULT_DURATION_S, pad_s: float = DEFAULT_PAD_S
-) -> tuple[np.ndarray, int]:
-    """The caregiver's word as audio: the stored voice parameters that produce it
-    (`say`) through the vocal DMP and VTL. Returns (waveform, rate Hz)."""
-    return synthesise(voice_trajectory(say(word)), duration_s=duration_s, pad_s=pad_s)

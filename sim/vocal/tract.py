@@ -17,7 +17,9 @@ from sim.vocal.audio import synthesise
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.formant_map import FormantMap, default_formant_map
 from sim.vocal.formants import tract_formants
+from sim.vocal.productions import synthesise_word
 from sim.vocal.voice import Voice
+from sim.vocal.words import vowel_targets
 
 
 class VocalTract(Voice):
@@ -29,6 +31,7 @@ class VocalTract(Voice):
     """
 
     name = "vtl"
+    sound_label = "sound: VocalTractLab"
 
     def __init__(
         self,
@@ -49,6 +52,14 @@ class VocalTract(Voice):
         self.n_fallbacks += int(np.size(ok) - np.count_nonzero(ok))
         return log2_hz
 
+    def vowel_targets(self) -> dict[str, np.ndarray]:
+        """The speaker's own vowels (sim/vocal/words.py), not the study's Hz values."""
+        return vowel_targets(self.config)
+
     def audio(self, artic_traj: np.ndarray) -> tuple[np.ndarray, int]:
         """VocalTractLab's synthesis of the trajectory, at the default duration and padding."""
         return synthesise(artic_traj, articulators=self.articulators)
+
+    def word_audio(self, word: str) -> tuple[np.ndarray, int]:
+        """The stored production of the word (sim/vocal/produce.py) through VocalTractLab."""
+        return synthesise_word(word)

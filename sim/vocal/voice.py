@@ -4,7 +4,8 @@ The world sends articulator frames (7 values in [-1, 1] each) and gets their for
 a 28-parameter vocal command goes through the vocal DMP (`sim.dmp.voice_trajectory`) to a (7, 50)
 articulator trajectory, whose formants at the 5 sample steps are the 10D sound features
 (docs/protocol.md §4), which the caregiver recognises as a word or not. A tract implements the
-formants of frames and the audio of a trajectory; the rest is common and lives here.
+formants of frames, its vowel targets (where in formant space its words lie) and the audio of a
+trajectory and of a word; the rest is common and lives here.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from models.layout import N_ARTICULATORS, SAMPLE_INDICES, VOICE_DIM
 from sim.config import WorldConfig
 from sim.dmp import voice_trajectory
 from sim.vocal.config import VoiceConfig
-from sim.vocal.words import normalise, recognise
+from sim.vocal.words import normalise, word_trajectory
 
 
 def check_box(x: np.ndarray, what: str) -> None:
@@ -40,6 +41,8 @@ class Voice(abc.ABC):
     """
 
     name: str
+    # What a video says of the sound it plays (experiments/video).
+    sound_label: str
 
     def __init__(self, exact: bool, config: VoiceConfig, world: WorldConfig) -> None:
         self.exact = exact
@@ -47,14 +50,29 @@ class Voice(abc.ABC):
         self.world = world
         self.n_fallbacks = 0
         self._sample_idx = np.array(SAMPLE_INDICES)
+        targets = self.vowel_targets()
+        self._targets = targets
+        words = np.stack(
+            [normalise(word_trajectory(w, targets, config), config) for w in config.words]
+        )
+        words.flags.writeable = False  # shared by every caller: nobody may change it in place
+        self._word_features = words
 
     @abc.abstractmethod
     def frame_formants(self, artic: np.ndarray) -> np.ndarray:
         """Checked articulator frames (..., 7) in [-1, 1] -> (..., 2) log2 Hz (F1, F2)."""
 
     @abc.abstractmethod
+    def vowel_targets(self) -> dict[str, np.ndarray]:
+        """Vowel name -> (2,) log2 Hz (F1, F2): where this tract's words lie."""
+
+    @abc.abstractmethod
     def audio(self, artic_traj: np.ndarray) -> tuple[np.ndarray, int]:
         """(7, n_steps) articulator trajectory -> (waveform, sample rate in Hz)."""
+
+    @abc.abstractmethod
+    def word_audio(self, word: str) -> tuple[np.ndarray, int]:
+        """The caregiver's word as audio: (waveform, sample rate in Hz)."""
 
     def formants(self, artic: np.ndarray) -> np.ndarray:
         """Articulator values (..., 7) in [-1, 1] -> (..., 2) log2 Hz (F1, F2)."""
@@ -97,6 +115,29 @@ class Voice(abc.ABC):
         traj = self.trajectory(m)
         return normalise(self.formants(traj[:, self._sample_idx].T), self.config)
 
+    # The words in this tract's formant space (sim/vocal/words.py) ----------------------------
+    def word_trajectory(self, word: str) -> np.ndarray:
+        """(5, 2) log2 Hz: the perfect trajectory of a word (v1, mid, v2, mid, v3)."""
+        return word_trajectory(word, self._targets, self.config)
+
+    def word_features(self, word: str) -> np.ndarray:
+        """(10,) normalised sound features of the perfect word."""
+        if word not in self.config.words:
+            raise ValueError(f"unknown word {word!r}; expected one of {self.config.words}")
+        return self._word_features[self.config.words.index(word)].copy()
+
+    def all_word_features(self) -> np.ndarray:
+        """(6, 10) read-only: the perfect features of config.words, in that order."""
+        return self._word_features
+
+    def word_distances(self, features: np.ndarray) -> np.ndarray:
+        """Euclidean distances (..., 6) from sound features (..., 10) to each word."""
+        diff = np.asarray(features, float)[..., None, :] - self._word_features
+        return np.sqrt(np.sum(diff**2, axis=-1))
+
     def recognise(self, features: np.ndarray) -> str | None:
-        """The word heard in a (10,) sound, or None (see `sim.vocal.words.recognise`)."""
-        return recognise(features, self.config)
+        """The word the caregiver hears in a (10,) sound: the nearest word if within
+        config.recognition_distance, else None."""
+        dist = self.word_distances(features)
+        best = int(np.argmin(dist))
+        return self.config.words[best] if dist[best] < self.config.recognition_distance else None

@@ -19,7 +19,7 @@ from sim import Playroom
 from sim import events as ev
 from sim.config import DEFAULT_WORLD
 from sim.vocal.config import DEFAULT_VOICE
-from sim.vocal.produce import say
+from sim.vocal.productions import say
 
 STUDY_WORLD = dataclasses.replace(DEFAULT_WORLD, dmp="study", catch_rule="study")
 

@@ -18,13 +18,14 @@ from learner.agent import Agent
 from learner.config import BABBLING_MODES, learner_preset
 from models.layout import ARM_DIM
 from models.presets import DEFAULT_PRESET, PRESETS
+from models.tracts import DEFAULT_TRACT
 from sim import Playroom
 from sim.config import DEFAULT_WORLD, STICK_RETURNS, world_preset
 from sim.grasping import registry
 from sim.grasping.kinematic import KinematicGrasp
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
 from sim.vocal.config import DEFAULT_VOICE
-from sim.vocal.registry import DEFAULT_TRACT, TRACTS, make_tract
+from sim.vocal.registry import TRACTS, make_tract
 from sim.vocal.voice import Voice
 
 

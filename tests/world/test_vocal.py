@@ -13,7 +13,7 @@ from sim.vocal.articulators import default_articulators, speaker_shapes
 from sim.vocal.audio import synthesise, write_wav
 from sim.vocal.config import DEFAULT_VOICE
 from sim.vocal.formants import FALLBACK_HZ, tract_formants, tube_formants
-from sim.vocal.produce import say, stored_distances
+from sim.vocal.productions import say, stored_distances
 from sim.vocal.tract import VocalTract
 from sim.vocal.words import (
     recognise,
