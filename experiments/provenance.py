@@ -197,8 +197,8 @@ def bit_differences(a: dict, b: dict) -> list[str]:
     Compared: the CPU model and architecture, numba's target CPU, NumPy's SIMD baseline and
     dispatched features, each BLAS library's name, version and kernel, the versions of the
     computing libraries (COMPUTING, Python included), the bit-changing environment variables,
-    and the commit when both records know it. Not compared: the host name (the same machine
-    image under another name computes the same bits), the time, the core count and BLAS
+    the user's data (`inputs`), and the commit when both records know it. Not compared: the
+    host name (the same machine image under another name computes the same bits), the time, the core count and BLAS
     threads (the machine's size, not its arithmetic: the trial's matrices are small), the
     platform string (the kernel's release), the dirty flag (it does not say what changed),
     and pandas, pyarrow, threadpoolctl, which only store and read results."""
@@ -220,6 +220,9 @@ def bit_differences(a: dict, b: dict) -> list[str]:
     ea, eb = _part(a, "environment"), _part(b, "environment")
     for key in sorted(set(ea) | set(eb)):
         differ(key, ea.get(key, "unset"), eb.get(key, "unset"))
+    ia, ib = _part(a, "inputs"), _part(b, "inputs")
+    for key in sorted(set(ia) | set(ib)):
+        differ(key, ia.get(key, "none"), ib.get(key, "none"))
     commit_a, commit_b = (_part(r, "source").get("commit") for r in (a, b))
     if commit_a and commit_b:
         differ("commit", commit_a[:10], commit_b[:10])
@@ -305,11 +308,14 @@ def read_entries(trial_dir: str | os.PathLike) -> list[dict] | None:
     return entries
 
 
-def record_start(trial_dir: str | os.PathLike, iteration: int) -> list[str]:
+def record_start(
+    trial_dir: str | os.PathLike, iteration: int, inputs: dict[str, str] | None = None
+) -> list[str]:
     """Append this machine's entry, computing from `iteration` on, to the trial's
-    provenance.json (written atomically; the caller holds the trial's lock). Entries from
-    `iteration` on are dropped: a resume discarded what they computed. Returns the lines to
-    tell the user: the code, machine or libraries changed since the previous entry, or a damaged
+    provenance.json (written atomically; the caller holds the trial's lock). `inputs`: data
+    the trial computes from that is the user's, not the project's (DIVA's map: its digest).
+    Entries from `iteration` on are dropped: a resume discarded what they computed. Returns the
+    lines to tell the user: the code, machine or libraries changed since the previous entry, or a damaged
     provenance.json was kept aside."""
     from experiments import storage
 
@@ -328,6 +334,8 @@ def record_start(trial_dir: str | os.PathLike, iteration: int) -> list[str]:
     if iteration > 0 and not entries:  # computed before provenance was recorded
         entries = [{"from_iteration": 0, "record": None}]
     record = machine_record()
+    if inputs:
+        record["inputs"] = dict(inputs)
     entries.append({"from_iteration": iteration, "record": record})
     storage.write_json(trial_dir / PROVENANCE_FILE, entries)
     previous = entries[-2] if len(entries) > 1 else None

@@ -11,6 +11,9 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import pytest  # noqa: E402
 
+# A generated DIVA map installed for a test (the real one is the user's): used across stages.
+from diva_files import installed_generated_map  # noqa: E402, F401
+
 
 @pytest.fixture(scope="session", autouse=True)
 def reference_cache(tmp_path_factory):

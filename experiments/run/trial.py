@@ -78,7 +78,9 @@ class Trial:
             if resume:
                 self._resume()
             if not self.finished:  # who computes from here on (provenance.json)
-                self.notices += provenance.record_start(self.dir, self.iteration)
+                self.notices += provenance.record_start(
+                    self.dir, self.iteration, self.room.vocal_tract.data_record()
+                )
         except BaseException:
             self.close()
             raise

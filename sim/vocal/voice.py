@@ -115,6 +115,11 @@ class Voice(abc.ABC):
         traj = self.trajectory(m)
         return normalise(self.formants(traj[:, self._sample_idx].T), self.config)
 
+    def data_record(self) -> dict[str, str]:
+        """What of the user's data this tract computes from, for a trial's provenance: {} for
+        a tract whose data ships with the project."""
+        return {}
+
     # The words in this tract's formant space (sim/vocal/words.py) ----------------------------
     def word_trajectory(self, word: str) -> np.ndarray:
         """(5, 2) log2 Hz: the perfect trajectory of a word (v1, mid, v2, mid, v3)."""

@@ -22,6 +22,7 @@ import hashlib
 import json
 import os
 import tempfile
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -197,16 +198,23 @@ def installed_fit() -> FormantFit:
 def _read_cache(path: Path) -> FormantFit:
     if not path.is_file():
         raise DivaDataMissing(
-            f"--voice diva needs DIVA's map, which is not installed ({path} is missing): get "
+            f"the voice diva needs DIVA's map, which is not installed ({path} is missing): get "
             f"{WHERE_TO_GET}, then run `playroom voice-data diva PATH`"
         )
-    with np.load(path) as stored:
-        meta = json.loads(str(stored["meta"]))
-        fit = FormantFit(
-            mu=stored["mu"], i_sigma=stored["i_sigma"], p=stored["p"], beta_fmt=stored["beta_fmt"]
-        )
+    damaged = DivaDataError(
+        f"{path} is damaged or not the study's map: run `playroom voice-data diva PATH` again"
+    )
+    try:
+        with np.load(path) as stored:
+            meta = json.loads(str(stored["meta"]))
+            fit = FormantFit(
+                mu=stored["mu"],
+                i_sigma=stored["i_sigma"],
+                p=stored["p"],
+                beta_fmt=stored["beta_fmt"],
+            )
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile):  # what a damaged npz raises
+        raise damaged from None
     if map_digest(fit) != meta.get("map_digest") or meta.get("map_digest") != STUDY_MAP_DIGEST:
-        raise DivaDataError(
-            f"{path} is damaged or not the study's map: run `playroom voice-data diva PATH` again"
-        )
+        raise damaged
     return fit

@@ -17,7 +17,7 @@ import numpy as np
 from models.layout import N_ARTICULATORS
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.diva.data import installed_fit
+from sim.vocal.diva.data import installed_fit, map_digest
 from sim.vocal.diva.fmfit import N_VOCAL_TRACT, FormantFit
 from sim.vocal.diva.sound import SOUND_LABEL, synthesise_formants
 from sim.vocal.voice import Voice
@@ -63,6 +63,10 @@ class DivaTract(Voice):
     ) -> None:
         self.fit = installed_fit() if fit is None else fit
         super().__init__(exact, config, world)
+
+    def data_record(self) -> dict[str, str]:
+        """The map's digest (sim/vocal/diva/data.py): which DIVA map the trial ran."""
+        return {"diva_map": map_digest(self.fit)}
 
     def formants_hz(self, artic: np.ndarray) -> np.ndarray:
         """(..., 7) checked frames -> (..., 3) DIVA's F1-F3 in Hz (any sign)."""
