@@ -19,6 +19,7 @@ from typing import Any
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import DISTANCE_ONE
+from experiments.analysis.study_maps import BOOTSTRAP_SAMPLES
 from experiments.analysis.study_summary import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
 from experiments.report.pages import Table, ci_text, num, p_value, pct, shares_text
 
@@ -157,11 +158,14 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         return pick(study[group]) if group in study else "not measured"
 
     def interval(numbers: dict, *keys: str) -> str:
-        """ " [95% CI a, b]" of the bootstrap over runs, if the numbers have one."""
-        bounds = numbers.get("intervals")
+        """ " [a, b]" of the bias-corrected bootstrap over runs; " [no interval]" where it was
+        computed but none contains the estimate; nothing where it was not computed."""
+        if "intervals" not in numbers:
+            return ""
+        bounds = numbers["intervals"]
         for key in keys:
-            bounds = None if bounds is None else bounds.get(key)
-        return "" if bounds is None else f" [{pct(bounds[0])}, {pct(bounds[1])}]"
+            bounds = bounds.get(key)
+        return " [no interval]" if bounds is None else f" [{pct(bounds[0])}, {pct(bounds[1])}]"
 
     def competence(numbers: dict) -> str:
         return pct(numbers["competence"]["all"]) + interval(numbers, "competence_all")
@@ -188,8 +192,10 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         [
             f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
             f"random reference of {commands} commands per ring, the study's "
-            f"{RANDOM_COMMANDS_PER_RING}; 95% intervals over runs resampled, given where the "
-            f"tests cover {pct(FULL_COVERAGE)} of the disk's pixels or more)",
+            f"{RANDOM_COMMANDS_PER_RING}; 95% bias-corrected (BC) bootstrap intervals over "
+            f"{BOOTSTRAP_SAMPLES} resamples of the runs, given where the tests cover "
+            f"{pct(FULL_COVERAGE)} of the disk's pixels or more and the estimate lies within "
+            "the central 95% of its resamples)",
             paper["competence_all"].text,
             *[of(x, competence) for x in groups],
         ],
