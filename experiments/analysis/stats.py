@@ -1,8 +1,9 @@
 """The report's statistics: pure functions on the tables of `experiments.analysis.results`.
 
 Proportions (competence, strategy shares) are fractions in [0, 1] (competence can be negative:
-worse than random); distances are the caregiver's word distances; costs are seconds. Tests are
-two-sided. Functions return NaN rather than raise where a test has too little data, so that a
+worse than random); distances are the caregiver's word distances; costs are seconds. Every p
+is two-sided; the Mann-Whitney p is the study's: the one-sided p doubled (docs/protocol.md
+D24). Functions return NaN rather than raise where a test has too little data, so that a
 small batch still gets a report with "n/a" where a number cannot be had.
 """
 
@@ -10,7 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -95,7 +96,8 @@ def strategy_table(competence: pd.DataFrame, hand_limit: float, stick_limit: flo
 
 def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
     """Share of words below the recognition threshold, median best distance of names and
-    distractors, and a two-sided Mann-Whitney U test of names against distractors.
+    distractors, and the Mann-Whitney U test of names against distractors (`mann_whitney`:
+    two-sided, the one-sided p doubled as the study did).
     `vocal`: one row per word with is_name and best_distance."""
     names = vocal.loc[vocal["is_name"], "best_distance"].to_numpy(dtype=float)
     distractors = vocal.loc[~vocal["is_name"], "best_distance"].to_numpy(dtype=float)
@@ -110,16 +112,19 @@ def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
     }
 
 
-def mann_whitney(
-    a: ArrayLike, b: ArrayLike, alternative: Literal["two-sided", "less", "greater"] = "two-sided"
-) -> tuple[float, float]:
-    """(U of a, p); NaN when a side is empty. Infinite values (a word never approached) rank
-    above every finite one, which is what they mean. alternative "less": a tends lower."""
+def mann_whitney(a: ArrayLike, b: ArrayLike) -> tuple[float, float]:
+    """(U of a, two-sided p); NaN when a side is empty. The p is the study's convention
+    (docs/protocol.md D24): the one-sided p in the direction the data lean, doubled and capped
+    at 1, which is what the study did with the one-sided p its scipy returned. Infinite values
+    (a word never approached) rank above every finite one, which is what they mean."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if len(a) == 0 or len(b) == 0:
         return math.nan, math.nan
-    result = stats.mannwhitneyu(a, b, alternative=alternative)
-    return float(result.statistic), float(result.pvalue)
+    less = stats.mannwhitneyu(a, b, alternative="less")
+    greater = stats.mannwhitneyu(a, b, alternative="greater")
+    # Written out rather than scipy's "two-sided" so that the convention is the code itself.
+    p = min(1.0, 2.0 * min(float(less.pvalue), float(greater.pvalue)))
+    return float(less.statistic), p
 
 
 def bias_corrected_interval(

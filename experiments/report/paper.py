@@ -141,7 +141,8 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
             *[num(vocal[x]["median_distractors"]) for x in g],
         ],
         [
-            "Mann-Whitney U, names vs distractors (two-sided)",
+            "Mann-Whitney U, names vs distractors "
+            "(two-sided p: the one-sided p doubled, as the study did)",
             paper["mann_whitney_p"].text,
             *[f"U = {num(vocal[x]['u'], 1)}, {p_value(vocal[x]['p'])}" for x in g],
         ],
