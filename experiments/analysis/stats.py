@@ -1,8 +1,9 @@
 """The report's statistics: pure functions on the tables of `experiments.analysis.results`.
 
 Proportions (competence, strategy shares) are fractions in [0, 1] (competence can be negative:
-worse than random); distances are the caregiver's word distances; costs are seconds. Tests are
-two-sided. Functions return NaN rather than raise where a test has too little data, so that a
+worse than random); distances are the caregiver's word distances; costs are seconds. Every p
+is two-sided; the Mann-Whitney p is the study's: the one-sided p doubled (docs/protocol.md
+D24). Functions return NaN rather than raise where a test has too little data, so that a
 small batch still gets a report with "n/a" where a number cannot be had.
 """
 
@@ -10,7 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -95,7 +96,8 @@ def strategy_table(competence: pd.DataFrame, hand_limit: float, stick_limit: flo
 
 def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
     """Share of words below the recognition threshold, median best distance of names and
-    distractors, and a two-sided Mann-Whitney U test of names against distractors.
+    distractors, and the Mann-Whitney U test of names against distractors (`mann_whitney`:
+    two-sided, the one-sided p doubled as the study did).
     `vocal`: one row per word with is_name and best_distance."""
     names = vocal.loc[vocal["is_name"], "best_distance"].to_numpy(dtype=float)
     distractors = vocal.loc[~vocal["is_name"], "best_distance"].to_numpy(dtype=float)
@@ -110,16 +112,55 @@ def vocal_summary(vocal: pd.DataFrame, threshold: float) -> dict[str, float]:
     }
 
 
-def mann_whitney(
-    a: ArrayLike, b: ArrayLike, alternative: Literal["two-sided", "less", "greater"] = "two-sided"
-) -> tuple[float, float]:
-    """(U of a, p); NaN when a side is empty. Infinite values (a word never approached) rank
-    above every finite one, which is what they mean. alternative "less": a tends lower."""
+def mann_whitney(a: ArrayLike, b: ArrayLike) -> tuple[float, float]:
+    """(U of a, two-sided p); NaN when a side is empty. The p is the study's convention
+    (docs/protocol.md D24): the one-sided p in the direction the data lean, doubled and capped
+    at 1, which is what the study did with the one-sided p its scipy returned. Infinite values
+    (a word never approached) rank above every finite one, which is what they mean."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if len(a) == 0 or len(b) == 0:
         return math.nan, math.nan
-    result = stats.mannwhitneyu(a, b, alternative=alternative)
-    return float(result.statistic), float(result.pvalue)
+    less = stats.mannwhitneyu(a, b, alternative="less")
+    greater = stats.mannwhitneyu(a, b, alternative="greater")
+    # Written out rather than scipy's "two-sided" so that the convention is the code itself.
+    p = min(1.0, 2.0 * min(float(less.pvalue), float(greater.pvalue)))
+    return float(less.statistic), p
+
+
+def bias_corrected_interval(
+    samples: ArrayLike, estimate: float, confidence: float = 0.95
+) -> tuple[float, float] | None:
+    """The bias-corrected (BC) bootstrap interval of `estimate` from its bootstrap `samples`:
+    z0 = Phi^-1(share of samples below the estimate, ties counted half), then the samples'
+    percentiles at Phi(2 z0 -+ z), z = Phi^-1(0.5 + confidence / 2) (Efron 1981). None where
+    no honest interval exists: a non-finite estimate or sample, or |z0| > z (the estimate lies
+    outside the central `confidence` of its own resamples; the BC interval, like the plain
+    percentile one, would then not contain it). As |z0| nears z, one end moves to the most
+    extreme resamples, so that end is a bound of the resamples, not of the sampling error.
+
+    Why BC and not BCa: the defect to correct is bias (the study's renormalised shares drop
+    in resamples that repeat runs), which z0 measures. BCa's acceleration corrects a standard
+    error that changes with the parameter, a smaller, second-order effect; its jackknife over
+    runs would be cheap here (n more rows of the resampling product), but a skewness estimated
+    from 32-100 leave-one-out values is itself noisy. Why ties count half: the point estimate
+    and a resample equal to it are the same sums added in another order, so they differ by
+    rounding only."""
+    samples = np.asarray(samples, dtype=float).ravel()
+    if not math.isfinite(estimate) or len(samples) == 0 or not np.isfinite(samples).all():
+        return None
+    tied = np.isclose(samples, estimate, rtol=1e-9, atol=1e-12)
+    share = (np.sum((samples < estimate) & ~tied) + 0.5 * np.sum(tied)) / len(samples)
+    z = float(stats.norm.ppf(0.5 + confidence / 2))
+    z0 = float(stats.norm.ppf(share))  # +-inf when every sample lies on one side
+    if not abs(z0) <= z:
+        return None
+    levels = stats.norm.cdf([2 * z0 - z, 2 * z0 + z])
+    low, high = (float(q) for q in np.percentile(samples, 100 * levels))
+    # The resamples are finitely many, so at |z0| close to z a percentile may step past the
+    # estimate: an interval that does not contain its estimate is not given.
+    if not low - 1e-12 <= estimate <= high + 1e-12:
+        return None
+    return low, high
 
 
 def paired_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float, float]:

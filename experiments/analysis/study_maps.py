@@ -1,5 +1,6 @@
 """The study's pixel maps (docs/protocol.md §10): competence and Fig. 4's strategy curve from
-test rows, as the study's notebooks computed them, and their 95% intervals over runs.
+test rows, as the study's notebooks computed them, and the bootstrap over runs behind their
+bias-corrected 95% intervals (`study_summary`).
 
 Tests are pooled per pixel of a GRID x GRID map of [-1, 1]^2 (pixel i holds x in
 [i / 50 - 1, (i + 1) / 50 - 1)), distances measured in pixels from pixel (50, 50) as the

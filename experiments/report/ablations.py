@@ -11,10 +11,11 @@ trials' config.json, so the table cannot name a setting that was not changed.
 Numbers per row, each computed as `playroom report` computes it (experiments.analysis.stats,
 experiments.measure.study_measure): the competence and strategy shares as the study computed them,
 the project's competence with the mean paired difference from the baseline (95% interval,
-paired t test), the share of words imitated within the recognition distance, the median best
-distance of names and distractors, and the one-sided Mann-Whitney test of names below
-distractors. Written: ablations.md (the table), ablations.csv (every number, unrounded),
-ablations.png (the paired differences and the names effect, one line per row).
+paired t test, two-sided), the share of words imitated within the recognition distance, the
+median best distance of names and distractors, and the Mann-Whitney test of names against
+distractors, its p two-sided as the study computed it (the one-sided p doubled; the convention
+is in the CSV column's name). Written: ablations.md (the table), ablations.csv (every number,
+unrounded), ablations.png (the paired differences and the names effect, one line per row).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from experiments import storage
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
-from experiments.analysis.stats import STRATEGIES, mann_whitney, paired_difference, vocal_summary
+from experiments.analysis.stats import STRATEGIES, paired_difference, vocal_summary
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
 
@@ -61,7 +62,8 @@ class AblationRow:
     words_within: float
     median_names: float
     median_distractors: float
-    names_below_p: float  # one-sided Mann-Whitney, names below distractors
+    # Mann-Whitney names vs distractors, the study's two-sided p (the one-sided p doubled).
+    names_vs_distractors_p_two_sided: float
 
 
 def describe_change(baseline: dict, config: dict) -> str:
@@ -88,8 +90,6 @@ def _row(
     study = measures.study_numbers(results).get(group)
     vocal = results.vocal
     summary = vocal_summary(vocal, Geometry.of(results).threshold)
-    names = vocal.loc[vocal["is_name"], "best_distance"]
-    distractors = vocal.loc[~vocal["is_name"], "best_distance"]
     difference = (math.nan,) * 4
     n_pairs = 0
     if baseline is not None:
@@ -114,7 +114,7 @@ def _row(
         words_within=summary["share_below"],
         median_names=summary["median_names"],
         median_distractors=summary["median_distractors"],
-        names_below_p=mann_whitney(names, distractors, alternative="less")[1],
+        names_vs_distractors_p_two_sided=summary["p"],
     )
 
 
@@ -178,8 +178,9 @@ def markdown_table(rows: list[AblationRow]) -> str:
     head = (
         "| configuration | trials | competence, study's measure | hand/tool/vocal centre | "
         "between limits | distance 1 | competence, project's measure (paired difference "
-        "from the baseline, 95% CI, p) | words within the recognition distance | median names / "
-        "distractors | names < distractors, one-sided p |"
+        "from the baseline, 95% CI, two-sided paired t p) | words within the recognition distance "
+        "| median names / distractors | names vs distractors, Mann-Whitney two-sided p (one-sided "
+        "doubled, as the study) |"
     )
     lines = [head, "|" + "---|" * 10]
     for row in rows:
@@ -198,7 +199,7 @@ def markdown_table(rows: list[AblationRow]) -> str:
             competence,
             _percent(row.words_within),
             f"{_number(row.median_names, '.2f')} / {_number(row.median_distractors, '.2f')}",
-            _number(row.names_below_p, ".2g"),
+            _number(row.names_vs_distractors_p_two_sided, ".2g"),
         ]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -285,7 +285,7 @@ def write_comparison(
         settings=settings_table(merged),
         configs=merged.configs,
         tests=Table(
-            ["statistic", g[0], g[1], "test of the difference", "p"],
+            ["statistic", g[0], g[1], "test of the difference", "p (two-sided)"],
             difference_rows(a, b, geometry, measures, grasp_rate_commands),
         ),
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),

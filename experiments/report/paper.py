@@ -2,9 +2,11 @@
 batch's numbers beside them.
 
 The numbers are data, not code, so that each carries where the paper states it (section,
-figure) and the paper's own words; the report shows the `text` of each, and lists the
-sources under the table. The file ships in the package (package-data) and is read with
-importlib.resources, so an installed wheel finds it too.
+figure), the paper's own words and how many runs it came from (the text's 500, or the 100 of
+the study's notebooks for the competence map and Fig. 4); the report shows the `text` of
+each with its run count, and lists the sources under the table. The file ships in the
+package (package-data) and is read with importlib.resources, so an installed wheel finds it
+too.
 """
 
 from __future__ import annotations
@@ -19,25 +21,36 @@ from typing import Any
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import DISTANCE_ONE
+from experiments.analysis.study_maps import BOOTSTRAP_SAMPLES
 from experiments.analysis.study_summary import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
 from experiments.report.pages import Table, ci_text, num, p_value, pct, shares_text
 
 PAPER_FILE = "paper.json"
 # A number the paper does not give (per ring competence): said so, not left blank.
 NOT_PUBLISHED = "not published"
+FIELDS = ("value", "text", "source", "quote", "runs", "runs_source")
 
 
 @dataclass(frozen=True)
 class PaperNumber:
     """One published number. value: a fraction in [0, 1], a word distance, a p value, or a
     dict of them ([low, high] where the paper gives a range); text: what the report shows;
-    source: where in the paper; quote: the paper's words."""
+    source: where in the paper; quote: the paper's words; runs: how many runs it was computed
+    from; runs_source: where that count comes from."""
 
     key: str
     value: Any
     text: str
     source: str
     quote: str
+    runs: int
+    runs_source: str
+
+    @property
+    def cell(self) -> str:
+        """The text with its run count, as a table shows it: the paper's numbers come from
+        different numbers of runs, so no column header can say it for all of them."""
+        return f"{self.text} (from {self.runs} runs)"
 
 
 def _read(path: Path | None) -> dict:
@@ -50,16 +63,16 @@ def _read(path: Path | None) -> dict:
 
 def load(path: Path | None = None) -> dict[str, PaperNumber]:
     """The numbers of `path` (default: the packaged data/paper.json), by key. ValueError
-    naming the key when an entry lacks value, text, source or quote."""
+    naming the key when an entry lacks one of FIELDS or its runs is not a positive integer."""
     numbers = {}
     for key, entry in _read(path)["numbers"].items():
-        missing = [f for f in ("value", "text", "source", "quote") if not entry.get(f)]
+        missing = [f for f in FIELDS if not entry.get(f)]
         if missing:
             # A number without its source is what this file exists to prevent.
             raise ValueError(f"{PAPER_FILE}: {key} lacks {', '.join(missing)}")
-        numbers[key] = PaperNumber(
-            key=key, **{f: entry[f] for f in ("value", "text", "source", "quote")}
-        )
+        if not isinstance(entry["runs"], int) or isinstance(entry["runs"], bool):
+            raise ValueError(f"{PAPER_FILE}: {key} runs must be a whole number of runs")
+        numbers[key] = PaperNumber(key=key, **{f: entry[f] for f in FIELDS})
     return numbers
 
 
@@ -76,10 +89,10 @@ def reference() -> str:
 
 
 def paper_header(groups: list[str], prefix: str = "") -> list[str]:
-    """Header of the paper table: result, the paper (with its runs), then one column per group
-    (each label after `prefix`, e.g. "this batch: ")."""
-    runs = published()["runs"].text
-    return ["result", f"paper ({runs})", *[f"{prefix}{g}" for g in groups]]
+    """Header of the paper table: result, the paper (each cell says its runs: they differ from
+    number to number), then one column per group (each label after `prefix`, e.g. "this
+    batch: ")."""
+    return ["result", "paper", *[f"{prefix}{g}" for g in groups]]
 
 
 def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list[list[str]]:
@@ -102,7 +115,7 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
     return [
         [
             "Normalised competence, all rings (mean over trials)",
-            paper["competence_all"].text,
+            paper["competence_all"].cell,
             *competence_of("all"),
         ],
         [f"… ring 1 (toy within hand reach, d < {h:g})", NOT_PUBLISHED, *competence_of("ring1")],
@@ -110,38 +123,39 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
         [f"… ring 3 ({s:g} ≤ d ≤ 1)", NOT_PUBLISHED, *competence_of("ring3")],
         [
             f"Strategy hand / tool / vocal, centre region (d < {h:g})",
-            paper["strategy_centre"].text,
+            paper["strategy_centre"].cell,
             *shares_of("centre"),
         ],
         [
             f"Strategy hand / tool / vocal, between hand and stick limits ({h:g} ≤ d < {s:g})",
-            paper["strategy_between_limits"].text,
+            paper["strategy_between_limits"].cell,
             *shares_of("between limits"),
         ],
         [
             f"Strategy hand / tool / vocal, at distance 1 (d ≥ {DISTANCE_ONE:g})",
-            paper["strategy_distance_1"].text,
+            paper["strategy_distance_1"].cell,
             *shares_of("distance 1"),
         ],
         *_study_rows(g, numbers.get("study", {}), paper),
         [
             f"Words imitated within {t:g} (best distance)",
-            paper["words_below_threshold"].text,
+            paper["words_below_threshold"].cell,
             *[f"{pct(vocal[x]['share_below'])} (of {vocal[x]['n_words']} words)" for x in g],
         ],
         [
             "Median best distance, toy names",
-            paper["median_names"].text,
+            paper["median_names"].cell,
             *[num(vocal[x]["median_names"]) for x in g],
         ],
         [
             "Median best distance, distractors",
-            paper["median_distractors"].text,
+            paper["median_distractors"].cell,
             *[num(vocal[x]["median_distractors"]) for x in g],
         ],
         [
-            "Mann-Whitney U, names vs distractors (two-sided)",
-            paper["mann_whitney_p"].text,
+            "Mann-Whitney U, names vs distractors "
+            "(two-sided p: the one-sided p doubled, as the study did)",
+            paper["mann_whitney_p"].cell,
             *[f"U = {num(vocal[x]['u'], 1)}, {p_value(vocal[x]['p'])}" for x in g],
         ],
     ]
@@ -157,11 +171,14 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         return pick(study[group]) if group in study else "not measured"
 
     def interval(numbers: dict, *keys: str) -> str:
-        """ " [95% CI a, b]" of the bootstrap over runs, if the numbers have one."""
-        bounds = numbers.get("intervals")
+        """ " [a, b]" of the bias-corrected bootstrap over runs; " [no interval]" where it was
+        computed but none contains the estimate; nothing where it was not computed."""
+        if "intervals" not in numbers:
+            return ""
+        bounds = numbers["intervals"]
         for key in keys:
-            bounds = None if bounds is None else bounds.get(key)
-        return "" if bounds is None else f" [{pct(bounds[0])}, {pct(bounds[1])}]"
+            bounds = bounds.get(key)
+        return " [no interval]" if bounds is None else f" [{pct(bounds[0])}, {pct(bounds[1])}]"
 
     def competence(numbers: dict) -> str:
         return pct(numbers["competence"]["all"]) + interval(numbers, "competence_all")
@@ -188,9 +205,11 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         [
             f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
             f"random reference of {commands} commands per ring, the study's "
-            f"{RANDOM_COMMANDS_PER_RING}; 95% intervals over runs resampled, given where the "
-            f"tests cover {pct(FULL_COVERAGE)} of the disk's pixels or more)",
-            paper["competence_all"].text,
+            f"{RANDOM_COMMANDS_PER_RING}; 95% bias-corrected (BC) bootstrap intervals over "
+            f"{BOOTSTRAP_SAMPLES} resamples of the runs, given where the tests cover "
+            f"{pct(FULL_COVERAGE)} of the disk's pixels or more and the estimate lies within "
+            "the central 95% of its resamples)",
+            paper["competence_all"].cell,
             *[of(x, competence) for x in groups],
         ],
         *[
@@ -200,17 +219,17 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
         ],
         [
             f"Strategy hand / tool / vocal, centre (Fig. 4's curve, x < 0.6), {label}",
-            paper["strategy_centre"].text,
+            paper["strategy_centre"].cell,
             *[of(x, shares("centre")) for x in groups],
         ],
         [
             f"Strategy hand / tool / vocal, between the limits (0.6 ≤ x < 0.85), {label}",
-            paper["strategy_between_limits"].text,
+            paper["strategy_between_limits"].cell,
             *[of(x, shares("between_limits")) for x in groups],
         ],
         [
             f"Strategy hand / tool / vocal, distance 1 (the curve's last bin), {label}",
-            paper["strategy_distance_1"].text,
+            paper["strategy_distance_1"].cell,
             *[of(x, shares("distance_1")) for x in groups],
         ],
     ]

@@ -99,6 +99,15 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
     csv = pd.read_csv(tmp_path / "out" / ABLATION_CSV_FILE)
     assert list(csv["n_trials"]) == [2, 2]
     assert {"difference", "difference_p", "study_distance_1_vocal"} <= set(csv.columns)
+    # The names effect's p: the study's convention, named in the column and the header.
+    vocal = pd.concat(pd.read_parquet(t / "vocal.parquet") for t in sigma_batch.glob("*-seed*"))
+    names, distractors = (vocal.loc[vocal["is_name"] == s, "best_distance"] for s in (True, False))
+    one_sided = min(
+        stats.mannwhitneyu(names, distractors, alternative=side).pvalue
+        for side in ("less", "greater")
+    )
+    assert csv["names_vs_distractors_p_two_sided"].iloc[1] == pytest.approx(min(1, 2 * one_sided))
+    assert "names vs distractors, Mann-Whitney two-sided p (one-sided doubled" in lines[0]
     assert (tmp_path / "out" / ABLATION_FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
 
 

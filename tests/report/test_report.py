@@ -314,17 +314,21 @@ def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypat
     ).read_text()
     published = paper.published()
     result, theirs, ours = _row(page, "Normalised competence, all rings")
-    assert theirs == published["competence_all"].text == "46% better than random on average"
+    assert theirs == published["competence_all"].cell
+    assert theirs == "46% better than random on average (from 100 runs)"
     assert ours.startswith(f"{100 * results.trials['competence_all'].mean():.1f}% [95% CI ")
     names = results.vocal.loc[results.vocal["is_name"], "best_distance"]
-    assert _row(page, "Median best distance, toy names")[1:] == ["0.23", f"{names.median():.2f}"]
+    assert _row(page, "Median best distance, toy names")[1:] == [
+        "0.23 (from 500 runs)",
+        f"{names.median():.2f}",
+    ]
     # The paper column is read from the data file, not written into the code.
     edited = dataclasses.replace(published["competence_all"], text="12% <b>edited</b>")
     monkeypatch.setattr(paper, "published", lambda: {**published, "competence_all": edited})
     page = write_report(
         batches["kinematic"], tmp_path / "edited", measures=room_measures(20)
     ).read_text()
-    assert _row(page, "Normalised competence, all rings")[1] == "12% <b>edited</b>"
+    assert _row(page, "Normalised competence, all rings")[1] == "12% <b>edited</b> (from 100 runs)"
 
 
 def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
