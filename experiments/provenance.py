@@ -198,9 +198,9 @@ def bit_differences(a: dict, b: dict) -> list[str]:
     dispatched features, each BLAS library's name, version and kernel, the versions of the
     computing libraries (COMPUTING, Python included), the bit-changing environment variables,
     the user's data (`inputs`), and the commit when both records know it. Not compared: the
-    host name (the same machine image under another name computes the same bits), the time, the core count and BLAS
-    threads (the machine's size, not its arithmetic: the trial's matrices are small), the
-    platform string (the kernel's release), the dirty flag (it does not say what changed),
+    host name (the same machine image under another name computes the same bits), the time,
+    the core count and BLAS threads (the machine's size, not its arithmetic: the trial's
+    matrices are small), the platform string (the kernel's release), the dirty flag (it does not say what changed),
     and pandas, pyarrow, threadpoolctl, which only store and read results."""
     out = []
 
@@ -315,8 +315,8 @@ def record_start(
     provenance.json (written atomically; the caller holds the trial's lock). `inputs`: data
     the trial computes from that is the user's, not the project's (DIVA's map: its digest).
     Entries from `iteration` on are dropped: a resume discarded what they computed. Returns the
-    lines to tell the user: the code, machine or libraries changed since the previous entry, or a damaged
-    provenance.json was kept aside."""
+    lines to tell the user: the code, machine or libraries changed since the previous entry, or
+    a damaged provenance.json was kept aside."""
     from experiments import storage
 
     trial_dir = Path(trial_dir)
