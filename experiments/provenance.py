@@ -200,8 +200,9 @@ def bit_differences(a: dict, b: dict) -> list[str]:
     the user's data (`inputs`), and the commit when both records know it. Not compared: the
     host name (the same machine image under another name computes the same bits), the time,
     the core count and BLAS threads (the machine's size, not its arithmetic: the trial's
-    matrices are small), the platform string (the kernel's release), the dirty flag (it does not say what changed),
-    and pandas, pyarrow, threadpoolctl, which only store and read results."""
+    matrices are small), the platform string (the kernel's release), the dirty flag (it does
+    not say what changed), and pandas, pyarrow, threadpoolctl, which only store and read
+    results."""
     out = []
 
     def differ(label: str, x: Any, y: Any) -> None:
