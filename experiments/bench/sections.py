@@ -7,6 +7,7 @@ Ratios are what to compare across machines; absolute times are printed beside th
 from __future__ import annotations
 
 import functools
+import math
 import time
 from collections.abc import Callable, Iterator
 
@@ -66,7 +67,10 @@ def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
     """The fitted formant map against the exact path, and the vocal part of an iteration."""
     from models.layout import VOICE_DIM
     from sim.dmp import voice_trajectory
+    from sim.vocal.diva.data import DivaDataError, DivaDataMissing
+    from sim.vocal.diva.tract import DivaTract
     from sim.vocal.tract import VocalTract
+    from sim.vocal.voice import Voice
     from sim.vocal.words import normalise
 
     rng = np.random.default_rng(0)
@@ -80,20 +84,32 @@ def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
     yield "formants_exact_per_frame", exact_s * 1e3, "ms"
     yield "formants_fast_map_per_frame", fast_s * 1e6, "us (in a movement of 50 frames)"
     yield "fast_map_speedup", exact_s / fast_s, "x (target >= 1000)"
-    commands = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
     samples = list(SAMPLE_INDICES)
 
-    def vocal_part() -> None:
+    def vocal_part_s(tract: Voice) -> float:
         # What act_voice does with the voice: the DMP, the formants of the 50 frames (the
         # sound sensor's readings), and the caregiver hearing the 5 samples.
-        formants = fast.formants(voice_trajectory(next(commands)).T)
-        fast.recognise(normalise(formants[samples]))
+        commands = iter(np.random.default_rng(1).uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
 
-    yield (
-        "act_voice_vocal_part",
-        _seconds_per_call(vocal_part, repeats) * 1e3,
-        ("ms (target <= 0.5)"),
-    )
+        def vocal_part() -> None:
+            formants = tract.formants(voice_trajectory(next(commands)).T)
+            tract.recognise(normalise(formants[samples]))
+
+        return _seconds_per_call(vocal_part, repeats)
+
+    vtl_s = vocal_part_s(fast)
+    yield "act_voice_vocal_part", vtl_s * 1e3, "ms (target <= 0.5)"
+    try:
+        diva: Voice | None = DivaTract(world=fast.world)
+    except (DivaDataMissing, DivaDataError):
+        diva = None
+    if diva is None:
+        yield "act_voice_vocal_part_diva", math.nan, "ms (not measured: DIVA's map not installed)"
+    else:
+        # Side by side in one run: DIVA's closed-form map against VTL's fast path.
+        diva_s = vocal_part_s(diva)
+        yield "act_voice_vocal_part_diva", diva_s * 1e3, "ms"
+        yield "diva_over_vtl_vocal_part", diva_s / vtl_s, "ratio (same commands, same run)"
     room = Playroom("kinematic", seed=0)
     voice = iter(rng.uniform(-1.0, 1.0, (3 * repeats, VOICE_DIM)))
     yield (

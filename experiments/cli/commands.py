@@ -287,3 +287,16 @@ def cmd_voice_data(args: argparse.Namespace) -> None:
     except DivaDataError as exc:
         raise UsageError(str(exc)) from None
     print(f"{args.path}: {what}; its map is installed in {where} (`--voice diva` uses it)")
+
+
+def cmd_sounds(args: argparse.Namespace) -> None:
+    """Random vocal commands against the words, one column per tract (the paper's Fig. 1b)."""
+    from experiments.measure.random_sounds import random_sound_table
+
+    tracts = tuple(dict.fromkeys(args.voice))  # in the order given, each once
+    table = random_sound_table(tracts, args.commands, args.seed, progress=True)
+    print(
+        f"{args.commands} random vocal commands (seed {args.seed}, the study preset's DMP); "
+        "distances in the 10D sound space, recognised below 0.4"
+    )
+    print(table.T.to_string(float_format=lambda x: f"{x:.3f}"))

@@ -21,6 +21,7 @@ from experiments.cli.commands import (
     cmd_report,
     cmd_run,
     cmd_say,
+    cmd_sounds,
     cmd_voice_data,
 )
 from experiments.cli.faults import run_command
@@ -164,6 +165,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="DIVA's diva_synth.mat (or divapy's fmfit_py.mat); left out: say what is installed",
     )
     p.set_defaults(func=cmd_voice_data)
+
+    p = sub.add_parser(
+        "sounds", help="random vocal commands against the words, in each vocal tract (Fig. 1b)"
+    )
+    p.add_argument(
+        "--voice",
+        nargs="+",
+        choices=TRACTS,
+        default=list(TRACTS),
+        help=f"the tracts to compare (default: {' '.join(TRACTS)}; diva needs its data installed)",
+    )
+    p.add_argument(
+        "--commands",
+        type=positive_int,
+        default=200,
+        help="random commands (default: 200, the paper's)",
+    )
+    p.add_argument("--seed", type=non_negative_int, default=0, help="of the commands (default: 0)")
+    p.set_defaults(func=cmd_sounds)
 
     p = sub.add_parser("say", help="write a word as audio (WAV), from the agent's voice")
     p.add_argument("word", help="one of the 6 words, e.g. oey")

@@ -39,6 +39,8 @@ from experiments.report.figures import STRATEGY_COLOURS, png_bytes
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
 BOOKKEEPING = ("trial.preset", "trial.overrides")
+# The world's copies of trial settings: a row says "trial.voice: vtl -> diva" once, not twice.
+MIRRORED = ("world.stick_return", "world.voice")
 # The study's regions, in the order the table shows them (experiments.measure.study_measure).
 STUDY_REGIONS = ("centre", "between_limits", "distance_1")
 
@@ -72,6 +74,7 @@ def describe_change(baseline: dict, config: dict) -> str:
         change
         for change in storage.config_differences(baseline, config)
         if not any(change[0] == key or change[0].startswith(f"{key}.") for key in BOOKKEEPING)
+        and change[0] not in MIRRORED
     ]
     if not changes:
         return "the baseline's settings"

@@ -35,6 +35,10 @@ class Table:
 # Numbers as text ------------------------------------------------------------------------------
 
 
+# How pages name the vocal tracts (models/tracts.py names them for settings).
+TRACT_NAMES = {"vtl": "VocalTractLab", "diva": "DIVA (the study's)"}
+
+
 def pct(x: float, digits: int = 0) -> str:
     """A fraction as a percentage ("46%"); "n/a" for NaN or inf."""
     return "n/a" if not np.isfinite(x) else f"{100 * x:.{digits}f}%"
@@ -82,7 +86,8 @@ def seeds_text(seeds: list[int]) -> str:
 
 
 def settings_table(results: BatchResults) -> Table:
-    """One row per group: trials, seeds, iterations, babbling, placements, package version."""
+    """One row per group: trials, seeds, iterations, babbling, preset, stick return, vocal
+    tract, placements, package version."""
     rows = []
     for group in results.groups:
         trials = results.trials[results.trials["group"] == group]
@@ -94,6 +99,9 @@ def settings_table(results: BatchResults) -> Table:
                 seeds_text(trials["seed"].tolist()),
                 str(config["trial"]["iterations"]),
                 str(config["trial"]["babbling"]),
+                str(config["trial"].get("preset", "?")),
+                str(config["world"].get("stick_return", "?")),
+                TRACT_NAMES.get(config["world"]["voice"], config["world"]["voice"]),
                 str(trials["n_placements"].iloc[0]),
                 str(config.get("package_version", "?")),
             ]
@@ -104,6 +112,9 @@ def settings_table(results: BatchResults) -> Table:
         "seeds",
         "iterations",
         "babbling",
+        "preset",
+        "stick return",
+        "vocal tract",
         "placements per ring",
         "package version",
     ]

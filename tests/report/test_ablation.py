@@ -151,10 +151,12 @@ def test_the_command_prints_the_table_and_names_a_bad_batch(batches, sigma_batch
     assert str(missing) in capsys.readouterr().err
 
 
-def test_each_ablation_config_changes_one_setting_of_its_preset():
+def test_each_ablation_config_changes_one_setting_of_its_preset(installed_generated_map):
     """The shipped ablations: `NAME.json` switches one study setting back to the project's,
     `project-plus-NAME.json` switches the same setting of the project preset to the study's,
-    `project.json` is the project preset's baseline; all on the replication's first seeds."""
+    `project.json` is the project preset's baseline; `diva.json` gives the study preset the
+    study's own vocal tract (no preset has it: its data is the user's); all on the
+    replication's first seeds."""
     from experiments.batches.spec import load_spec
     from experiments.run.settings import full_config
 
@@ -162,7 +164,7 @@ def test_each_ablation_config_changes_one_setting_of_its_preset():
     files = sorted((f for f in folder.iterdir() if f.name.endswith(".json")), key=lambda f: f.name)
     assert len(files) >= 3, f"no shipped ablation configs in {folder}"
     names = {f.name.removesuffix(".json") for f in files}
-    assert {f"project-plus-{n}" for n in names if not n.startswith("project")} <= names
+    assert {f"project-plus-{n}" for n in names - {"diva"} if not n.startswith("project")} <= names
     for path in files:
         spec = load_spec(config_file=Path(str(path)))
         assert spec.seeds == tuple(range(32)) and spec.iterations == 80000
@@ -173,6 +175,12 @@ def test_each_ablation_config_changes_one_setting_of_its_preset():
         stem = path.name.removesuffix(".json")
         if stem == "project":
             assert settings.preset == "project" and changes == []
+            continue
+        if stem == "diva":
+            assert settings.preset == "study" and settings.voice == "diva" and changes == []
+            vtl = full_config(dataclasses.replace(settings, voice="vtl"))
+            changes = config_differences(vtl, full_config(settings))
+            assert [c[0] for c in changes] == ["trial.voice", "world.voice"]
             continue
         assert settings.preset == ("project" if stem.startswith("project") else "study")
         assert len(changes) == 1, f"{path.name} changes {changes}"
