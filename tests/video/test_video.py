@@ -388,3 +388,29 @@ def test_render_refuses_bad_trial_input_with_one_line(tmp_path, capsys, trained_
         assert len(err.strip().splitlines()) == 1, err
     assert not list(tmp_path.glob("*.mp4"))
     assert sorted((p.relative_to(trial), p.stat().st_mtime_ns) for p in trial.rglob("*")) == before
+
+
+def test_a_diva_film_sounds_through_its_tract_and_says_what_the_sound_is(
+    tmp_path, installed_generated_map
+):
+    """A DIVA room's voice and words come from DIVA's formants through the formant synthesizer,
+    and every frame's caption says the sound is not DIVA's own."""
+    from sim.vocal.diva.sound import SOUND_LABEL
+
+    out = tmp_path / "diva.mp4"
+    captions = []
+    real_draw = episodes.Overlay.draw
+
+    def draw(self, frame, view, caption, *args):
+        captions.append(caption.sound)
+        return real_draw(self, frame, view, caption, *args)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(episodes.Overlay, "draw", draw)
+        episodes.render_random(
+            "kinematic", 3, out, 2, SIZE, voice="diva", sound=True, lead_frames=0, hold_frames=0
+        )
+    assert captions and set(captions) == {SOUND_LABEL}
+    assert "Audio:" in stream_listing(out)
+    wave, _ = decoded_sound(out, tmp_path)
+    assert np.abs(wave).max() > 1000  # the agent's sound or the caregiver's word is heard
