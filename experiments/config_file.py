@@ -13,7 +13,11 @@ from __future__ import annotations
 import copy
 
 # Dotted key -> the value every trial written before the setting existed ran with.
-ADDED_SETTINGS: dict[str, object] = {"trial.voice": "vtl", "world.voice": "vtl"}
+ADDED_SETTINGS: dict[str, object] = {
+    "trial.voice": "vtl",
+    "world.voice": "vtl",
+    "world.stick_return_reach": None,
+}
 
 
 def with_added_settings(config: dict) -> dict:

@@ -59,6 +59,13 @@ class WorldConfig:
     # The experimenter returns a stick beyond the hand's reach to its start pose between
     # iterations ("out_of_reach"), or never, as in the study (sim/experimenter.py, §11).
     stick_return: str = "out_of_reach"
+    # The physical backend's experimenter also returns a stick whose handle (the context's
+    # stick position, the logs' `stick_distance`) lies farther than this from the arm's base (m).
+    # None: only when no contact can take it (no point of the handle geom within the arm's
+    # length plus the hand's and the handle's radii, 0.546 m), the rule every trial so far ran
+    # with. A setting, not a change: docs/protocol.md D14 proposes a value measured from where
+    # the learning arm still grasps the stick, to be decided and re-measured.
+    stick_return_reach: float | None = None
     # The vocal tract (sim/vocal/registry.py): "vtl", VocalTractLab, this project's; or "diva",
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
     # D13).
@@ -84,6 +91,8 @@ class WorldConfig:
         check_choice(w + "catch_rule", self.catch_rule, CATCH_RULES)
         check_number(w + "caregiver_bring_rate", self.caregiver_bring_rate, "(0, 1]")
         check_choice(w + "stick_return", self.stick_return, STICK_RETURNS)
+        if self.stick_return_reach is not None:
+            check_number(w + "stick_return_reach", self.stick_return_reach, "(0, inf)")
         check_choice(w + "voice", self.voice, TRACTS)
 
     @property

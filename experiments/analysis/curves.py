@@ -93,3 +93,40 @@ def tool_numbers(log: pd.DataFrame, reach: float) -> dict[str, float]:
         "stick_in_reach": float(frame["stick_in_reach"].mean()) if has_stick else np.nan,
         "stick_returns": float(frame["stick_returned"].sum()) if has_stick else np.nan,
     }
+
+
+def grasp_rate_by_distance(log: pd.DataFrame, bin_width: float = 0.01) -> pd.DataFrame:
+    """How often the hand takes the stick against where the stick lies: per bin [low, high)
+    of the handle's distance from the arm's base when an arm movement began (`stick_distance`,
+    the context's), the arm movements begun there (`iterations`), those that took the stick
+    (`grasps`) and their share (`rate`); bins without a movement are left out. Arm movements
+    only: the physical hand grasps in no other, and the study's kinematic rule of the resting
+    hand in vocal movements is not reaching. `log`: one trial's iterations log, or several
+    concatenated (logs predating `stick_distance` cannot say where the stick lay)."""
+    if bin_width <= 0:
+        raise ValueError(f"bin_width must be positive, got {bin_width!r}")
+    arm = log[log["motor_space"] == "arm"]
+    index = np.floor(arm["stick_distance"].to_numpy(dtype=float) / bin_width).astype(int)
+    grouped = arm["stick_grasped"].astype(bool).groupby(index)
+    table = pd.DataFrame({"iterations": grouped.size(), "grasps": grouped.sum().astype(int)})
+    table["rate"] = table["grasps"] / table["iterations"]
+    table.insert(0, "low", table.index * bin_width)
+    table.insert(1, "high", (table.index + 1) * bin_width)
+    return table.reset_index(drop=True)
+
+
+def falling_rate_distance(
+    rates: pd.DataFrame, start: float, fraction: float = 0.5, min_iterations: int = 100
+) -> float:
+    """The near edge of the first bin of `grasp_rate_by_distance` beyond the one holding
+    `start` (the stick's start distance, m) whose rate is below `fraction` of that bin's:
+    where the arm, as it learned to move, stops reaching the stick. Bins of fewer than
+    `min_iterations` movements are too noisy to decide and are passed over. NaN when no bin
+    falls so low, or the start's bin is too small."""
+    at_start = rates[(rates["low"] <= start) & (start < rates["high"])]
+    if at_start.empty or at_start["iterations"].iloc[0] < min_iterations:
+        return float("nan")
+    floor = fraction * float(at_start["rate"].iloc[0])
+    beyond = rates[(rates["low"] > start) & (rates["iterations"] >= min_iterations)]
+    below = beyond[beyond["rate"] < floor]
+    return float(below["low"].iloc[0]) if not below.empty else float("nan")

@@ -9,7 +9,9 @@ How the study's code measured (its scripts/run.py and analysis notebooks):
 - strategy: the arm or the voice model of the toy, whichever has the nearer experience (a tie
   goes to the voice); when the voice model had data, the arm model's inverse was queried with
   the voice model's context values (toy, caregiver) in place of its own (stick, toy);
-- a test used the tool when the stick's x moved between the first and the last sample;
+- a test used the tool when the stick's x moved between the first and the last sample (any
+  difference at all; the rows keep that difference, `stick_dx`, so that a report can also
+  count the tool uses that moved the stick less than a minimum motion);
 - placements: drawn anew in every run (the study used the global random state), so that
   pooled over runs the tests cover the whole disk; here from the trial's own seed;
 - random reference (notebook motor_babbling): per ring, 10000 placements, one random command
@@ -75,7 +77,8 @@ def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
 
 
 def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
-    """One row per test: ring, toy, x, y (the toy's position), strategy, error."""
+    """One row per test: ring, toy, x, y (the toy's position), strategy, stick_dx (the stick's
+    x at the last sample minus at the first, m), error."""
     rng = np.random.default_rng([settings.seed, room.seed])
     rows = []
     for ring_number, ring in enumerate(room.config.toy_rings, start=1):
@@ -106,6 +109,9 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
                         "x": position[0],
                         "y": position[1],
                         "strategy": strategy_of(space, bool(stick_x[0] != stick_x[-1])),
+                        # m, what the rule compared: reports count the tool uses it made of
+                        # sub-millimetre motions (experiments/analysis/stats.py, tool_motion).
+                        "stick_dx": float(stick_x[-1] - stick_x[0]),
                         "error": float(np.linalg.norm(s[block_slice(toy)] - goal)),
                     }
                 )

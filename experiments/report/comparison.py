@@ -36,7 +36,7 @@ from experiments.analysis.stats import (
     welch,
 )
 from experiments.file_names import COMPARISON_FILE
-from experiments.report import name_strategies, paper
+from experiments.report import name_strategies, paper, tool_rule
 from experiments.report.batch_report import numbers_and_figures
 from experiments.report.figures import FigureFile
 from experiments.report.pages import (
@@ -248,6 +248,7 @@ def difference_rows(
         *_strategy_rows(a, b, geometry),
         *_vocal_rows(a, b, geometry.threshold),
         *_stick_rows(a, b, geometry),
+        *tool_rule.comparison_rows(a, b),
         *_grasp_rate_row(a, b, grasp_rate_commands, measures),
         *_cost_rows(a, b),
     ]
@@ -295,5 +296,6 @@ def write_comparison(
         where=where,
         where_note=where_note,
         **name_strategies.page_context(merged, geometry.threshold),
+        **tool_rule.page_context(merged),
     )
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page)

@@ -122,7 +122,12 @@ class PhysicalGrasp(GraspBackend):
     # The experimenter ---------------------------------------------------------------------
     def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
         """No point of the handle geom lies within the arm's length plus the radii of the hand
-        sphere and of the handle: contact is impossible."""
+        sphere and of the handle: contact is impossible; or, with `stick_return_reach` set, the
+        handle lies farther than it from the base (docs/protocol.md D14: where the learning arm
+        stops grasping, nearer than where contact stops being possible)."""
+        reach = self.config.stick_return_reach
+        if reach is not None and np.hypot(*physics.stick_handle()) > reach:
+            return True
         m, d = physics.model.ptr, physics.data.ptr
         handle = physics.handle_geom
         axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z

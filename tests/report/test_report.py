@@ -87,6 +87,7 @@ def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     assert "2 trials" in text and "this batch: kinematic" in text
     assert (out / "fig4-strategies-as-the-study-computed-it.png").exists()  # study tests held
     assert "as the study computed it (paper Fig. 4)" in text
+    assert "<h2>Tool use and a minimum motion</h2>" in text
     assert not list(out.glob(".*.tmp"))
 
 
@@ -111,6 +112,9 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
         "Stick returns by the experimenter per trial",
         "Tool tests: stick held / only pushed",
         "Random arm commands that grasp the stick at its start",
+        # The study's tool rule beside a minimum motion (tests/report/test_tool_rule.py).
+        "tool uses that moved the stick",  # the page escapes the apostrophes
+        "<h2>Tool use and a minimum motion</h2>",
     ):
         assert statistic in text, statistic
     assert (out / "comparison-stick.png").exists()

@@ -63,3 +63,19 @@ def test_an_unknown_rule_is_refused():
     # Refused where the config is built, before any room is made with it.
     with pytest.raises(ValueError, match="stick_return must be one of 'never', 'out_of_reach'"):
         dataclasses.replace(DEFAULT_WORLD, stick_return="sometimes")
+
+
+# A handle 0.53 m from the base, the stick pointing outward: its handle geom lies within the
+# contact limit (0.546 m), so only a `stick_return_reach` nearer than 0.53 m returns it.
+NEAR_LIMIT = (0.53, 0.0, 0.0)
+
+
+@pytest.mark.parametrize(("reach", "returned"), [(None, False), (0.54, False), (0.52, True)])
+def test_the_physical_return_reach_is_a_setting(reach, returned):
+    config = dataclasses.replace(DEFAULT_WORLD, stick_return_reach=reach)
+    room = Playroom("physical", seed=0, config=config)
+    room.arrange(stick=NEAR_LIMIT, toys=PARKED_TOYS)
+    feedback = room.act("voice", np.zeros(VOICE_DIM))
+    assert (ev.STICK_RETURNED in feedback.kinds()) == returned
+    where = DEFAULT_WORLD.stick_start_handle if returned else NEAR_LIMIT[:2]
+    np.testing.assert_allclose(room.context()[:2], where, atol=1e-3)
