@@ -60,12 +60,12 @@ class WorldConfig:
     # iterations ("out_of_reach"), or never, as in the study (sim/experimenter.py, §11).
     stick_return: str = "out_of_reach"
     # The physical backend's experimenter also returns a stick whose handle (the context's
-    # stick position, the logs' `stick_distance`) lies farther than this from the arm's base (m).
-    # None: only when no contact can take it (no point of the handle geom within the arm's
-    # length plus the hand's and the handle's radii, 0.546 m), the rule every trial so far ran
-    # with. A setting, not a change: docs/protocol.md D14 proposes a value measured from where
-    # the learning arm still grasps the stick, to be decided and re-measured.
-    stick_return_reach: float | None = None
+    # stick position, the logs' `stick_distance`) lies farther than this from the arm's base (m):
+    # where the learning arm's grasp rate falls below half its rate at the start pose, measured
+    # on physical trials (docs/protocol.md D14). None: only when no contact can take it (no
+    # point of the handle geom within the arm's length plus the hand's and the handle's radii,
+    # 0.546 m), the rule of every trial written before this setting (experiments/config_file.py).
+    stick_return_reach: float | None = 0.53
     # The vocal tract (sim/vocal/registry.py): "vtl", VocalTractLab, this project's; or "diva",
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
     # D13).

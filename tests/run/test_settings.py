@@ -280,12 +280,12 @@ def test_a_trial_stored_with_a_bad_setting_is_refused_in_one_line(short_trial, c
     assert {p.name: p.read_bytes() for p in short_trial.iterdir() if p.is_file()} == before
 
 
-def test_the_stick_return_reach_by_default_is_the_contact_limit_as_before():
-    # No setting: the rule every trial ran with (tests/world/test_stick_return.py), so no
-    # measured result changes; a config.json written before the setting existed reads back
-    # with that default, and a trial's identity leaves the default out (its checkpoints
+def test_older_trials_keep_the_contact_limit_as_their_stick_return_reach():
+    # New trials return the physical stick beyond the measured 0.53 m (docs/protocol.md D14);
+    # a config.json written before the setting existed reads back with the rule it ran with,
+    # the contact limit (None), and a trial's identity leaves that value out (its checkpoints
     # stay its own).
-    assert DEFAULT_WORLD.stick_return_reach is None
+    assert DEFAULT_WORLD.stick_return_reach == 0.53
     assert with_added_settings({"world": {}})["world"]["stick_return_reach"] is None
     form = identity_form({"world": {"stick_return_reach": None, "dmp": "study"}})
     assert form["world"] == {"dmp": "study"}
