@@ -32,7 +32,7 @@ from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import backend_class
 from sim.model_edits import ModelEdits
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
-from sim.task import ARM, VOICE, PlayroomTask
+from sim.task import ARM, VOICE, MovementStepper, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.registry import make_tract
 
@@ -51,6 +51,11 @@ class Playroom:
     when it loads. The vocal tract is the one `config.voice` names (sim/vocal/registry.py).
     exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
     a frame) instead of the fitted formant map (microseconds); for audio checks.
+
+    `task` and `physics` are the dm_control Task and Physics; `env` is the room's internal
+    stepping (sim.task.MovementStepper), which acts only inside a movement `act` began and is
+    never reset after the room is built. A room has no episodes: environments with `reset`,
+    one command a step, are in sim/envs/.
     """
 
     def __init__(
@@ -74,9 +79,8 @@ class Playroom:
         self.backend = backend(config, ModelEdits(self.physics))
         self.caregiver = Caregiver(self.backend, config, self.vocal_tract, self.rng)
         self.task = PlayroomTask(self.backend, self.caregiver, self.vocal_tract)
-        self.env = control.Environment(
-            self.physics, self.task, n_sub_steps=CONTROL_SUBSTEPS, time_limit=float("inf")
-        )
+        # Internal stepping for observed movements (videos), reset once here: see its docstring.
+        self.env = MovementStepper(self.physics, self.task, CONTROL_SUBSTEPS)
         self.experimenter = Experimenter(config, self.physics, self.backend)
         self.env.reset()
         self.iteration = 0

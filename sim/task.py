@@ -2,8 +2,13 @@
 
 The action of a step is 10 numbers: the 3 joint targets of the arm (rad, relative to rest)
 and the 7 articulators of the vocal tract (in [-1, 1]). A movement uses one of the two: the
-task is told which by `begin_movement`, and the other part of the action is ignored. The
-vocal tract is a non-physical sensor: its formants are the `sound` observation.
+task is told which by `begin_movement`, and the other part of the action is ignored; a step
+outside a movement is refused. The vocal tract is a non-physical sensor: its formants are the
+`sound` observation.
+
+`MovementStepper` is the dm_control Environment through which `Playroom` steps this task while
+someone watches each step (videos). It is the room's internal stepping, not an environment to
+act in: environments that act, one command a step, are in sim/envs/.
 """
 
 from __future__ import annotations
@@ -59,6 +64,13 @@ class PlayroomTask(control.Task):
         )
 
     def before_step(self, action: np.ndarray, physics: PlayroomPhysics) -> None:
+        if self.movement is None:
+            # Outside a movement the action would be ignored: say so instead of doing nothing.
+            raise RuntimeError(
+                "the playroom task steps only inside a movement: use Playroom.act (or "
+                "task.begin_movement first), or an environment of sim.envs to act one command "
+                "a step"
+            )
         self.step_index += 1
         self.step_events = []
         if self.movement == ARM:
@@ -116,3 +128,31 @@ class PlayroomTask(control.Task):
         self.caregiver.stop(physics)
         self.movement = None
         self.sound[:] = 0.0
+
+
+class MovementStepper(control.Environment):
+    """The dm_control Environment `Playroom` steps a movement through while step observers
+    watch (`room.env`): the room's internal stepping, not an environment to act in.
+
+    A step acts only inside a movement the room began (`PlayroomTask.before_step` refuses
+    others), and the room does its own bookkeeping around it (iterations, placements, the
+    caregiver's words). It is reset once, when the room is built: a later `reset()` would put
+    the objects back at the keyframe without the room knowing, so it is refused. To start
+    again, build a new `Playroom`; to act one command a step, with resets and episodes, use
+    sim/envs/ (a dm_env and a Gymnasium environment).
+    """
+
+    def __init__(self, physics: PlayroomPhysics, task: PlayroomTask, n_sub_steps: int) -> None:
+        # No time limit: a room's life is as long as its trial; episodes are sim/envs/'s.
+        super().__init__(physics, task, n_sub_steps=n_sub_steps, time_limit=float("inf"))
+        self._started = False
+
+    def reset(self):
+        if self._started:
+            raise RuntimeError(
+                "room.env is the room's internal stepping and is reset only when the room is "
+                "built: build a new Playroom(seed=...), or use sim.envs for an environment "
+                "with reset(seed)"
+            )
+        self._started = True
+        return super().reset()

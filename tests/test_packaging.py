@@ -45,6 +45,7 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
     assert "models/playroom.xml" in names
     assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
     assert "experiments/batches/profiles/demo.json" in names
+    assert {"sim/envs/__init__.py", "sim/envs/dm_env_movement.py", "sim/envs/gym_env.py"} <= names
     # The voice's build-time fitting script is not installed (pyproject.toml excludes it).
     assert not [n for n in names if n.startswith("sim/vocal/fitting")]
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]

@@ -77,9 +77,29 @@ def test_room_is_built_on_a_dm_control_environment():
     assert isinstance(room.task, control.Task)
     assert isinstance(room.env, control.Environment)
     assert room.env.action_spec().shape == (10,)
-    obs = room.env.step(np.zeros(10)).observation
+    # Inside a movement the room began, a step applies its joint targets.
+    rest = room.physics.hand_position().copy()
+    room.task.begin_movement(room.physics, "arm")
+    for _ in range(20):
+        obs = room.env.step(np.r_[np.full(3, 0.5), np.zeros(7)]).observation
     assert set(obs) == {"hand", "stick_handle", "stick_tip", "toys", "caregiver", "sound"}
     assert obs["toys"].shape == (3, 2)
+    assert np.linalg.norm(obs["hand"] - rest) > 0.1
+    room.task.end_movement(room.physics)
+
+
+def test_room_env_refuses_steps_outside_a_movement_and_resets():
+    # room.env is the room's internal stepping: what would be ignored or put the room out of
+    # step with its own bookkeeping is refused, pointing to sim.envs.
+    room = Playroom("kinematic", seed=0, config=PROJECT)
+    state = room.get_state()
+    with pytest.raises(RuntimeError, match="only inside a movement.*sim.envs"):
+        room.env.step(np.r_[np.full(3, 0.5), np.zeros(7)])
+    with pytest.raises(RuntimeError, match="internal stepping.*sim.envs"):
+        room.env.reset()
+    after = room.get_state()
+    np.testing.assert_array_equal(after["physics"], state["physics"])
+    assert after["iteration"] == state["iteration"]
 
 
 # Scripted motions, found by optimisation over the DMP parameters ---------------------------
