@@ -165,7 +165,7 @@ def test_a_real_scheduler_passes_the_check():
 _started, _release = threading.Event(), threading.Event()
 
 
-def _held_task(trial_dir, settings, eval_placements, topic=None) -> dict:
+def _held_task(trial_dir, settings, eval_placements, *reporting) -> dict:
     _started.set()
     _release.wait(60)
     return {}
