@@ -169,6 +169,34 @@ def cmd_render(args: argparse.Namespace) -> None:
     print(path)
 
 
+def cmd_view(args: argparse.Namespace) -> None:
+    """A trial replayed, or random commands, live in MuJoCo's viewer (needs a display)."""
+    from experiments.video import gl
+    from experiments.video.viewer import ViewError, display_missing
+
+    missing = display_missing()
+    if missing is not None:
+        raise UsageError(missing)
+    if (args.dir is None) == (not args.random):
+        raise UsageError("give a trial directory or --random (one of the two)")
+    if not args.pace > 0:
+        raise UsageError(f"--pace must be > 0, got {args.pace}")
+    try:
+        gl.for_viewing()  # before anything imports mujoco
+    except gl.GLError as exc:
+        raise UsageError(str(exc)) from None
+    from experiments.video.viewer import view_random, view_trial
+
+    try:
+        if args.random:
+            shown = view_random(args.grasp, args.seed, args.iterations, args.voice, args.pace)
+        else:
+            shown = view_trial(args.dir, args.start, args.iterations, args.pace)
+    except ViewError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"{shown} iterations shown")
+
+
 def cmd_report(args: argparse.Namespace) -> None:
     """Figures and report.html of a batch, its numbers beside the paper's."""
     from experiments.analysis.results import ReportError

@@ -30,6 +30,7 @@ from experiments.cli.commands import (
     cmd_run,
     cmd_say,
     cmd_sounds,
+    cmd_view,
     cmd_voice_data,
 )
 from experiments.cli.faults import run_command
@@ -224,6 +225,32 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_render)
 
+    p = sub.add_parser(
+        "view", help="watch a trial replayed, or a random agent, live in MuJoCo's viewer"
+    )
+    p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")
+    p.add_argument("--random", action="store_true", help="random commands in a new room")
+    p.add_argument(
+        "--from",
+        dest="start",
+        type=non_negative_int,
+        default=0,
+        metavar="I",
+        help="the trial's first iteration to show (the earlier ones are replayed unseen)",
+    )
+    p.add_argument("--iterations", type=positive_int, default=20, help="iterations to show")
+    p.add_argument(
+        "--grasp", choices=GRASPS, default=DEFAULT_GRASP, help="with --random: the grasp backend"
+    )
+    p.add_argument(
+        "--seed", type=non_negative_int, default=0, help="with --random: of room and commands"
+    )
+    _voice_option(p, f"with --random; default: {DEFAULT_TRACT}", default=DEFAULT_TRACT)
+    p.add_argument(
+        "--pace", type=float, default=1.0, help="speed against real time (2: twice as fast)"
+    )
+    p.set_defaults(func=cmd_view)
+
     p = sub.add_parser("voice-data", help="install the data a vocal tract needs (DIVA's map)")
     p.add_argument("tract", choices=["diva"], help="the tract whose data it is")
     p.add_argument(
@@ -268,7 +295,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # Commands that render choose an OpenGL backend themselves; the others load none.
-RENDERING_COMMANDS = ("render", "bench")
+RENDERING_COMMANDS = ("render", "bench", "view")
 
 
 def main(argv: list[str] | None = None) -> int:

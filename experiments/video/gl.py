@@ -43,6 +43,20 @@ def without_rendering() -> None:
         os.environ.setdefault(VARIABLE, NO_BACKEND)
 
 
+def for_viewing() -> None:
+    """For the interactive viewer (`playroom view`): GLFW, which opens windows; GLError if the
+    user chose another backend or mujoco was imported with one."""
+    chosen = os.environ.setdefault(VARIABLE, "glfw").strip().lower()
+    if chosen != "glfw":
+        raise GLError(f"the viewer opens a window with GLFW: unset {VARIABLE} (it is {chosen!r})")
+    if "mujoco" in sys.modules:
+        import mujoco
+
+        loaded = getattr(getattr(mujoco, "GLContext", None), "__module__", "none")
+        if loaded.split(".")[-1] != "glfw":
+            raise GLError(f"mujoco was imported with another OpenGL backend ({loaded})")
+
+
 def missing_library(backend: str) -> str | None:
     """The one-line message for a backend whose system library cannot be found, else None."""
     import ctypes.util
