@@ -298,10 +298,22 @@ def build_parser() -> argparse.ArgumentParser:
 RENDERING_COMMANDS = ("render", "bench", "view")
 
 
+def _command_parser(parser: argparse.ArgumentParser, command: str) -> argparse.ArgumentParser:
+    """The parser of one command (`playroom run`, ...)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return action.choices[command]
+    return parser
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
+        if extra:  # said by the command's own parser, with its usage line, not the top one's
+            _command_parser(parser, args.command).error(
+                f"unrecognized arguments: {' '.join(extra)}"
+            )
     except SystemExit as exc:  # --help, --version, or argparse's own error (usage, exit 2)
         return exc.code if isinstance(exc.code, int) else 0
     if args.command not in RENDERING_COMMANDS:
