@@ -66,7 +66,7 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     def _get_help_string(self, action: argparse.Action) -> str | None:
         text = action.help or ""
         if (
-            action.default in (None, False, argparse.SUPPRESS)
+            any(action.default is x for x in (None, False, argparse.SUPPRESS))  # 0 is shown
             or "default" in text
             or (not action.option_strings and action.nargs not in ("?", "*"))
         ):

@@ -164,7 +164,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--workers", type=positive_int, help="local worker processes (default: cores)")
     _set_option(p, "merged into the batch's overrides")
-    p.add_argument("--quiet", action="store_true", help="no progress bar, no dashboard link")
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress bar (the dashboard's link is still printed)",
+    )
     p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser("report", help="figures and report.html of a batch beside the paper")

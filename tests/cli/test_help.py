@@ -34,7 +34,7 @@ def test_every_option_of_every_command_has_help():
     "command, shown",
     [
         ("run", ["default: 80000", "default: kinematic", "{kinematic,physical}", "--set"]),
-        ("random", ["(default: 20)", "(default: kinematic)"]),
+        ("random", ["(default: 20)", "(default: kinematic)", "(default: 0)"]),
         ("render", ["(default: 640x480)", "(default: 50.0)", "(default: top)"]),
         ("eval", ["(default: 100)"]),
         ("batch", ["smoke", "paper", "dashboard", "--set"]),
