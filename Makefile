@@ -33,23 +33,20 @@ lock:
 install: $(INSTALLED)
 
 DEMO := $(OUT)/demo
-# The demo's reports play a tenth of the study's random reference (3000 commands per ring, not
-# 30000; the reports say so): the physical backend's full reference alone takes minutes.
-DEMO_REFERENCE := --study-reference-commands 3000
 
 ## run: the main job: the demo batch (both backends), its report and the comparison
 run: experiment
-	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare $(DEMO_REFERENCE)
+	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare
 
 ## experiment: the demo profile's batch and its report
 experiment: $(INSTALLED)
 	$(BIN)/playroom batch --profile demo --out $(DEMO)
-	$(BIN)/playroom report $(DEMO) $(DEMO_REFERENCE)
+	$(BIN)/playroom report $(DEMO)
 
 ## compare: the demo profile's two backends and their comparison
 compare: $(INSTALLED)
 	$(BIN)/playroom batch --profile demo --out $(DEMO)
-	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare $(DEMO_REFERENCE)
+	$(BIN)/playroom compare $(DEMO) $(DEMO) --out $(OUT)/compare
 
 ## video: the highlights of the demo batch's first physical trial
 video: $(INSTALLED)

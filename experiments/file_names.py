@@ -44,6 +44,9 @@ STUDY_TESTS_FILE = "study-tests.parquet"
 # Seconds and iterations of the batch task that last ran the trial.
 TIMING_FILE = "timing.json"
 
+# What a batch is: its spec as `playroom batch` last ran it (experiments/batches/spec.py).
+BATCH_FILE = "batch.json"
+
 # Pages about a batch ------------------------------------------------------------------------
 REPORT_FILE = "report.html"
 COMPARISON_FILE = "comparison.html"

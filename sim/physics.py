@@ -6,11 +6,11 @@ import os
 
 import mujoco
 import numpy as np
-from dm_control import mujoco as dm_mujoco
 
 from models import playroom_xml
 from models.layout import TOYS
 from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.dm_control_import import dm_mujoco
 
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
 OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw

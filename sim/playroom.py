@@ -6,7 +6,6 @@ from collections.abc import Callable
 
 import mujoco
 import numpy as np
-from dm_control.rl import control
 
 from models.layout import (
     ARM_DIM,
@@ -25,6 +24,7 @@ from models.world import Feedback
 from sim import events as ev
 from sim.caregiver import Caregiver, WordAssignment
 from sim.config import WorldConfig, world_preset
+from sim.dm_control_import import control
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
 from sim.grasping.base import ClosedForm

@@ -16,12 +16,12 @@ from __future__ import annotations
 import collections
 
 import numpy as np
-from dm_control.rl import control
 from dm_env import specs
 
 from models.layout import N_ARTICULATORS, N_JOINTS
 from sim import events as ev
 from sim.caregiver import Caregiver
+from sim.dm_control_import import control
 from sim.grasping.base import GraspBackend
 from sim.physics import PlayroomPhysics
 from sim.vocal.voice import Voice

@@ -28,8 +28,15 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.batches import scheduler as dask_scheduler
-from experiments.batches.spec import BatchError, BatchSpec
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, EVAL_FILE, TIMING_FILE
+from experiments.batches.progress import REPORT_EVERY, BatchProgress, dashboard_link, reporter
+from experiments.batches.spec import BatchError, BatchSpec, spec_record
+from experiments.file_names import (
+    BATCH_FILE,
+    CHECKPOINT_FILE,
+    CONFIG_FILE,
+    EVAL_FILE,
+    TIMING_FILE,
+)
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.lock import DirectoryLock, DirectoryLocked
@@ -63,10 +70,16 @@ def is_complete(trial_dir: Path) -> bool:
 
 
 def run_and_evaluate(
-    trial_dir: str, settings: TrialSettings, eval_placements: int, topic: str | None = None
+    trial_dir: str,
+    settings: TrialSettings,
+    eval_placements: int,
+    topic: str | None = None,
+    progress_topic: str | None = None,
+    report_every: int = REPORT_EVERY,
 ) -> dict:
     """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
-    for another writer of the trial is told to the client listening on `topic`."""
+    for another writer of the trial is told to the client listening on `topic`, the iteration
+    the trial reached (every `report_every`) to the one listening on `progress_topic`."""
     path = Path(trial_dir)
     # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
     # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
@@ -87,7 +100,10 @@ def run_and_evaluate(
     try:
         resume = (path / "config.json").exists()
         start = time.perf_counter()
-        trial = run_trial(path, settings, resume=resume, progress=False)
+        trial = run_trial(
+            path, settings, resume=resume, progress=False,
+            report=reporter(progress_topic, path.name), report_every=report_every,
+        )  # fmt: skip
         if trial.elapsed is not None:
             # Only the iterations run now are timed, so resumed trials still give a fair cost.
             storage.write_json(
@@ -121,11 +137,15 @@ def run_batch(
     client=None,
     progress: bool = True,
     notify: Callable[[str], None] | None = None,
+    report_every: int = REPORT_EVERY,
 ) -> dict[str, dict]:
     """Run every trial of `spec` under out_dir (skipping completed ones); returns the
     evaluation summary of each trial run now, by name. Trials that fail are reported and the
     others go on; BatchError at the end names the failures, or at once says the scheduler is
-    not one or was lost. `notify` gets the lines said while trials run (default: stderr)."""
+    not one or was lost. The Dask dashboard's link is printed on stderr first; `notify` gets
+    the lines said while trials run (default: stderr); `progress`: a bar of the iterations
+    done across the trials, moved every `report_every` iterations of each
+    (experiments/batches/progress.py)."""
     from distributed import as_completed
 
     # Workers may run in another directory, or on another machine sharing the file system:
@@ -136,6 +156,7 @@ def run_batch(
     todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
     skipped = len(spec.trials()) - len(todo)
     if not todo:
+        _record(spec, out)
         if progress:
             print(f"{out}: all {skipped} trials already complete")
         return {}
@@ -145,11 +166,12 @@ def run_batch(
             client, own_cluster = dask_scheduler.connect(scheduler, n_workers)
         except dask_scheduler.SchedulerError as exc:
             raise BatchError(str(exc)) from None
-    bar = tqdm(total=len(todo), disable=not progress, desc="batch", unit="trial")
+    shown = BatchProgress({n: s.iterations for n, s in todo}, enabled=progress)
     if notify is None:
-        notify = lambda line: bar.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
+        notify = lambda line: tqdm.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
     run = uuid.uuid4().hex[:8]
     topic = f"playroom-batch-{run}"
+    progress_topic = f"{topic}-progress"
     results: dict[str, dict] = {}
     failures: dict[str, str] = {}
     listening = False
@@ -158,7 +180,13 @@ def run_batch(
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise BatchError(f"cannot create {out}: {exc.strerror}") from None
+        _record(spec, out)
+        # Where to watch the cluster (tasks, workers, memory), whichever cluster it is.
+        link = dashboard_link(client)
+        where = link or "none (the scheduler serves none)"
+        tqdm.write(f"batch: Dask dashboard: {where}", file=sys.stderr)
         dask_scheduler.listen(client, topic, notify)
+        shown.listen(client, progress_topic)
         listening = True
         futures = {}
         for name, settings in todo:
@@ -166,11 +194,11 @@ def run_batch(
             key = task_key(name, trial_dir, settings, spec.eval_placements, run)
             future = client.submit(
                 run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
-                key=key, pure=False, retries=2,
+                progress_topic, report_every, key=key, pure=False, retries=2,
             )  # fmt: skip
             futures[future] = name
         if skipped and progress:
-            bar.write(f"skipping {skipped} complete trial(s)")
+            tqdm.write(f"skipping {skipped} complete trial(s)", file=sys.stderr)
         for future in as_completed(futures):
             name = futures[future]
             try:
@@ -180,35 +208,33 @@ def run_batch(
                 if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
                     raise _lost(scheduler, todo, results) from None
                 failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
-            bar.update(1)
-            try:
-                threads = sum(client.nthreads().values())
-            except OSError:  # the scheduler went away
-                raise _lost(scheduler, todo, results) from None
-            # Dask may queue more tasks on a worker than it has threads: at most one task per
-            # thread runs, the rest of the unfinished ones wait.
-            unfinished = sum(not f.done() for f in futures)
-            running = min(unfinished, threads)
-            bar.set_postfix(
-                done=len(results), running=running, waiting=unfinished - running,
-                failed=len(failures),
-            )  # fmt: skip
+            shown.ended(name, failed=name in failures)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (experiments/cli/faults.py)
         # The workers' complaints about being closed mid-trial would follow the command's one
         # line; their trials resume from their checkpoints.
         logging.getLogger("distributed").setLevel(logging.CRITICAL)
         raise
     finally:
-        bar.close()
+        shown.close()
         if own_cluster is not None:
             client.close()
             own_cluster.close()
         elif listening and not dask_scheduler.scheduler_lost(client):
             client.unsubscribe_topic(topic)
+            client.unsubscribe_topic(progress_topic)
     if failures:
         listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
         raise BatchError(f"{len(failures)} trial(s) failed: {listed}")
     return results
+
+
+def _record(spec: BatchSpec, out: Path) -> None:
+    """Write what the batch is into its directory (batch.json): its reports read the size of
+    the study's random reference from it (experiments/analysis/batch_record.py)."""
+    try:
+        storage.write_json(out / BATCH_FILE, spec_record(spec))
+    except OSError as exc:
+        raise BatchError(f"cannot write {out / BATCH_FILE}: {exc.strerror}") from None
 
 
 def _lost(scheduler: str | None, todo: list, results: dict) -> BatchError:

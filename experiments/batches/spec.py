@@ -13,6 +13,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TypeGuard
 
+from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
@@ -39,7 +40,9 @@ FIELD_RULES = {
     "preset": f"one of {', '.join(PRESETS)}",
     "voice": f"one of {', '.join(TRACTS)}",
     "overrides": 'an object {"world": {...}, "learner": {...}}',
+    "study_reference_commands": "a positive integer (random commands per ring)",
     "description": "a string",
+    "base": f"the name of a stored profile ({', '.join(stored_profiles())})",
 }
 
 
@@ -68,6 +71,10 @@ class BatchSpec:
     preset: str = DEFAULT_PRESET
     voice: str = DEFAULT_TRACT
     overrides: dict = field(default_factory=dict)
+    # Random commands per ring behind the study's measure when this batch is reported
+    # (`playroom report`, `compare`, `ablations`): the study's 30000 at its scale, fewer for
+    # batches of short trials, whose report would otherwise take minutes for seconds of trials.
+    study_reference_commands: int = RANDOM_COMMANDS_PER_RING
     description: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
@@ -87,7 +94,12 @@ class BatchSpec:
         twice = sorted(s for s, n in Counter(self.seeds).items() if n > 1)
         if twice:
             raise BatchError(f"seeds must be distinct: {twice} given more than once")
-        for name in ("iterations", "checkpoint_every", "eval_placements"):
+        for name in (
+            "iterations",
+            "checkpoint_every",
+            "eval_placements",
+            "study_reference_commands",
+        ):
             value = getattr(self, name)
             if not _is_int(value) or value <= 0:
                 raise _field_error(name, value)
@@ -134,6 +146,57 @@ class BatchSpec:
                 full_config(dataclasses.replace(first, grasp=grasp, babbling=babbling))
 
 
+def spec_record(spec: BatchSpec) -> dict:
+    """The spec as a batch directory records it (batch.json): every field, as JSON."""
+    return json.loads(json.dumps(dataclasses.asdict(spec)))
+
+
+def with_overrides(spec: BatchSpec, overrides: dict) -> BatchSpec:
+    """`spec` with other overrides (`playroom batch --set`), checked as a config's are."""
+    try:
+        changed = dataclasses.replace(spec, overrides=overrides)
+        changed.check_configs()
+    except (BatchError, TrialError) as exc:
+        raise BatchError(f"--set: {exc}") from None
+    return changed
+
+
+def _read_fields(text: str, source: str) -> dict:
+    """The fields of a batch config's JSON text, each name known."""
+    try:
+        raw = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise BatchError(f"{source} is not valid JSON ({exc})") from None
+    if not isinstance(raw, dict):
+        raise BatchError(f"{source} must hold a JSON object of the fields {', '.join(FIELD_RULES)}")
+    unknown = sorted(set(raw) - set(FIELD_RULES))
+    if unknown:
+        raise BatchError(
+            f"{source}: unknown field(s) {', '.join(unknown)}; known: {', '.join(FIELD_RULES)}"
+        )
+    return dict(raw)
+
+
+def _with_base(given: dict, source: str) -> dict:
+    """A config's fields on top of its "base" profile's, if it names one: what it leaves out is
+    the base's (its own description aside), its overrides added to the base's per section."""
+    if "base" not in given:
+        return given
+    base = given.pop("base")
+    if not isinstance(base, str) or base not in stored_profiles():
+        raise BatchError(f"{source}: {_field_error('base', base)}")
+    text = resources.files("experiments.batches").joinpath("profiles", f"{base}.json").read_text()
+    fields = _read_fields(text, f"profile {base}")
+    if "base" in fields:  # one level: a profile is read as it stands
+        raise BatchError(f"profile {base} has a base itself: a base must be a whole profile")
+    fields.pop("description", None)
+    mine, theirs = given.get("overrides", {}), fields.get("overrides", {})
+    both = (mine, theirs, *getattr(mine, "values", list)(), *getattr(theirs, "values", list)())
+    if all(isinstance(o, dict) for o in both):  # else left for BatchSpec to refuse
+        mine = {k: {**theirs.get(k, {}), **mine.get(k, {})} for k in {*theirs, *mine}}
+    return {**fields, **given, "overrides": mine}
+
+
 def load_spec(
     profile: str | None = None, config_file: str | os.PathLike | None = None
 ) -> BatchSpec:
@@ -157,18 +220,7 @@ def load_spec(
             text, source = path.read_text(), str(path)
         except (OSError, UnicodeDecodeError) as exc:
             raise BatchError(f"cannot read batch config {path}: {exc}") from None
-    try:
-        raw = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise BatchError(f"{source} is not valid JSON ({exc})") from None
-    if not isinstance(raw, dict):
-        raise BatchError(f"{source} must hold a JSON object of the fields {', '.join(FIELD_RULES)}")
-    unknown = sorted(set(raw) - set(FIELD_RULES))
-    if unknown:
-        raise BatchError(
-            f"{source}: unknown field(s) {', '.join(unknown)}; known: {', '.join(FIELD_RULES)}"
-        )
-    given = dict(raw)
+    given = _with_base(_read_fields(text, source), source)
     # JSON has lists where the spec has tuples; nothing else is converted.
     for name in ("grasps", "babbling", "seeds"):
         if isinstance(given.get(name), list):

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator
 import mujoco
 import numpy as np
 
+from experiments.bench.names import SECTION_NAMES
 from experiments.bench.tracking import hand_tracking_errors
 from models.layout import ARM_DIM, N_STEPS, SAMPLE_INDICES
 from sim import Playroom
@@ -223,6 +224,10 @@ SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "voice": voice_figures,
     "render": render_section,
 }
+
+# The command line's list (experiments/bench/names.py) names exactly these, in this order.
+if tuple(SECTIONS) != SECTION_NAMES:
+    raise RuntimeError(f"experiments/bench/names.py lists {SECTION_NAMES}, not {tuple(SECTIONS)}")
 
 
 def run_bench(sections: list[str] | None = None) -> None:

@@ -58,8 +58,50 @@ def iteration_list(text: str) -> list[int]:
     return values
 
 
-class Parser(argparse.ArgumentParser):
-    """argparse, with errors on one line (exit code 2) instead of usage plus message."""
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """argparse's help with each option's default at the end of its line, except where there
+    is none to show (None, a flag's False) or the help already says it (a `run` option's
+    default depends on --resume)."""
 
-    def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message}\n")
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if (
+            any(action.default is x for x in (None, False, argparse.SUPPRESS))  # 0 is shown
+            or "default" in text
+            or (not action.option_strings and action.nargs not in ("?", "*"))
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with the defaults in every help (`HelpFormatter`). Its own errors (a bad
+    option) keep argparse's form: the command's usage line, then the message, exit code 2;
+    a command's own errors (`UsageError`) are one line (experiments/cli/faults.py)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
+class VersionAction(argparse.Action):
+    """`--version`: the package's version and, in a git checkout, its commit. Computed only
+    when asked (git is not run for every command)."""
+
+    def __init__(self, option_strings: list[str], dest: str, help: str | None = None) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help=help)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: Any) -> NoReturn:
+        print(version_text())
+        parser.exit()
+
+
+def version_text() -> str:
+    """'playroom 0.1.0 (commit ce04631+dirty)', or '(installed package)' outside a checkout."""
+    from importlib.metadata import version
+
+    from experiments.provenance import commit_text, source_record
+
+    source = source_record()
+    where = ("commit " if source.get("commit") else "") + commit_text(source)
+    return f"playroom {version('playroom')} ({where})"

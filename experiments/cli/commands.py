@@ -11,6 +11,7 @@ from collections import Counter
 import numpy as np
 
 from experiments.cli.args import RUN_DEFAULTS, UsageError
+from experiments.cli.overrides import merged
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -46,6 +47,8 @@ def cmd_run(args: argparse.Namespace) -> None:
     # Options left out are None: a new trial takes the documented defaults, a resumed one
     # its own settings, which those given must match.
     given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
+    if args.set:
+        given["overrides"] = merged({}, args.set)
     try:
         if args.resume:
             settings = resume_settings(args.out, given)
@@ -108,11 +111,16 @@ def cmd_eval(args: argparse.Namespace) -> None:
 def cmd_batch(args: argparse.Namespace) -> None:
     """Many trials on Dask, each run and evaluated; reruns skip what is complete."""
     from experiments.batches.runner import run_batch
-    from experiments.batches.spec import BatchError, load_spec
+    from experiments.batches.spec import BatchError, load_spec, with_overrides
 
     try:
         spec = load_spec(args.profile, args.config)
-        results = run_batch(spec, args.out, scheduler=args.scheduler, n_workers=args.workers)
+        if args.set:
+            spec = with_overrides(spec, merged(spec.overrides, args.set))
+        results = run_batch(
+            spec, args.out, scheduler=args.scheduler, n_workers=args.workers,
+            progress=not args.quiet,
+        )  # fmt: skip
     except BatchError as exc:
         raise UsageError(str(exc)) from None
     for name, summary in sorted(results.items()):
@@ -140,7 +148,7 @@ def cmd_render(args: argparse.Namespace) -> None:
             count = len(args.iterations) if args.iterations else 4
             path = render_random(
                 args.grasp, args.seed, args.out, iterations=count, size=args.size,
-                fps=args.fps, camera=args.camera, voice=args.voice, sound=True,
+                fps=args.fps, camera=args.camera, voice=args.voice, sound=True, progress=True,
             )  # fmt: skip
             print(path)
             return
@@ -161,13 +169,41 @@ def cmd_render(args: argparse.Namespace) -> None:
     print(path)
 
 
+def cmd_view(args: argparse.Namespace) -> None:
+    """A trial replayed, or random commands, live in MuJoCo's viewer (needs a display)."""
+    from experiments.video import gl
+    from experiments.video.viewer import ViewError, display_missing
+
+    missing = display_missing()
+    if missing is not None:
+        raise UsageError(missing)
+    if (args.dir is None) == (not args.random):
+        raise UsageError("give a trial directory or --random (one of the two)")
+    if not args.pace > 0:
+        raise UsageError(f"--pace must be > 0, got {args.pace}")
+    try:
+        gl.for_viewing()  # before anything imports mujoco
+    except gl.GLError as exc:
+        raise UsageError(str(exc)) from None
+    from experiments.video.viewer import view_random, view_trial
+
+    try:
+        if args.random:
+            shown = view_random(args.grasp, args.seed, args.iterations, args.voice, args.pace)
+        else:
+            shown = view_trial(args.dir, args.start, args.iterations, args.pace)
+    except ViewError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"{shown} iterations shown")
+
+
 def cmd_report(args: argparse.Namespace) -> None:
     """Figures and report.html of a batch, its numbers beside the paper's."""
     from experiments.analysis.results import ReportError
     from experiments.report.batch_report import write_report
 
     try:
-        print(write_report(args.dir, args.out, **_study_reference(args)))
+        print(write_report(args.dir, args.out, **_study_reference(args, [args.dir])))
     except ReportError as exc:
         raise UsageError(str(exc)) from None
 
@@ -183,7 +219,7 @@ def cmd_compare(args: argparse.Namespace) -> None:
                 args.dir_a,
                 args.dir_b,
                 args.out,
-                **_study_reference(args),
+                **_study_reference(args, [args.dir_a, args.dir_b]),
                 **_grasp_rate_commands(args),
             )
         )
@@ -197,7 +233,10 @@ def cmd_ablations(args: argparse.Namespace) -> None:
     from experiments.report.ablations import write_ablations
 
     try:
-        table = write_ablations(args.baseline, args.batches, args.out, **_study_reference(args))
+        dirs = [args.baseline, *args.batches]
+        table = write_ablations(
+            args.baseline, args.batches, args.out, **_study_reference(args, dirs)
+        )
     except ReportError as exc:
         raise UsageError(str(exc)) from None
     print(table.read_text(), end="")
@@ -255,13 +294,14 @@ def _grasp_rate_commands(args: argparse.Namespace) -> dict:
     return {} if n is None else {"grasp_rate_commands": n}
 
 
-def _study_reference(args: argparse.Namespace) -> dict:
+def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
     """The room measures a report shows (measured here, by the measuring stage: a report
-    builds no room), with the reference size asked for, if any (the default is the study's,
-    experiments.analysis.study_summary)."""
+    builds no room), with the reference size asked for, else the one the batches record (their
+    profile's), else the study's (experiments.analysis.study_summary)."""
+    from experiments.analysis.batch_record import recorded_reference_commands
     from experiments.measure.for_reports import room_measures
 
-    n = args.study_reference_commands
+    n = args.study_reference_commands or recorded_reference_commands(batch_dirs)
     return {"measures": room_measures() if n is None else room_measures(n)}
 
 

@@ -76,9 +76,20 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
     }
 
 
-def grasp_rates(n_commands: int = 1000, seed: int = 0) -> dict[str, float]:
+def grasp_rates(
+    n_commands: int = 1000, seed: int = 0, progress: bool | None = None
+) -> dict[str, float]:
     """Share of random arm commands that grasp the stick, per backend, each command from the
-    same scene: the stick at its start pose, the toys where the room's seed placed them."""
+    same scene: the stick at its start pose, the toys where the room's seed placed them.
+    progress: a bar on stderr (None: only on a terminal)."""
+    from tqdm import tqdm
+
+    bar = tqdm(
+        total=n_commands * len(GRASPS),
+        disable=None if progress is None else not progress,
+        desc="grasp rates",
+        unit="command",
+    )
     rng = np.random.default_rng(seed)
     commands = rng.uniform(-1.0, 1.0, (n_commands, ARM_DIM))
     start = (*DEFAULT_WORLD.stick_start_handle, DEFAULT_WORLD.stick_start_angle)
@@ -91,5 +102,7 @@ def grasp_rates(n_commands: int = 1000, seed: int = 0) -> dict[str, float]:
         for m in commands:
             room.arrange(stick=start, toys=toys)
             grasped += ev.STICK_GRASPED in room.act("arm", m).kinds()
+            bar.update(1)
         rates[grasp] = grasped / n_commands
+    bar.close()
     return rates

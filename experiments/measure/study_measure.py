@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
 import models
 import sim
@@ -118,10 +119,20 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
     return pd.DataFrame(rows)
 
 
-def random_reference(room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
-    """One row per random command: x, y of the goal toy and the error read on toy 1."""
+def random_reference(
+    room: Playroom, settings: StudyMeasureSettings, progress: bool | None = None, label: str = ""
+) -> pd.DataFrame:
+    """One row per random command: x, y of the goal toy and the error read on toy 1. progress:
+    a bar on stderr (None: only on a terminal), named `label`."""
     rng = np.random.default_rng(settings.seed + 1)
     rows = []
+    total = len(room.config.toy_rings) * settings.random_commands_per_ring
+    bar = tqdm(
+        total=total,
+        disable=None if progress is None else not progress,
+        desc=f"study reference{' ' + label if label else ''}",
+        unit="command",
+    )
     for ring in room.config.toy_rings:
         for k in range(settings.random_commands_per_ring):
             if k % len(TOYS) == 0:
@@ -133,6 +144,8 @@ def random_reference(room: Playroom, settings: StudyMeasureSettings) -> pd.DataF
             s = room.act(space, rng.uniform(-1, 1, MOTOR_DIMS[space])).s
             error = float(np.linalg.norm(s[block_slice("toy1")] - goal_trajectory(position)))
             rows.append({"x": position[0], "y": position[1], "error": error})
+            bar.update(1)
+    bar.close()
     return pd.DataFrame(rows)
 
 
@@ -192,13 +205,15 @@ def study_numbers(
     results,
     commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
     cache_dir: Path | None = None,
+    progress: bool | None = None,
 ) -> dict[str, dict]:
     """`study_summary` of each group of a batch (`experiments.analysis.results.BatchResults`) whose
     trials hold the study's tests: their tests pooled over trials (the study averaged errors
     per pixel over its runs), against a random reference played in a fresh room of the
     group's settings. The reference depends on the settings and the code alone: it is kept in
     `cache_dir` (default: `reference_cache_dir()`) as `study-reference-<digest>.parquet` and
-    read back by later reports, comparisons and ablations of any batch of those settings."""
+    read back by later reports, comparisons and ablations of any batch of those settings.
+    progress: a bar for each reference played (None: only on a terminal)."""
     from experiments.run.trial_files import fresh_trial_parts
 
     cache = Path(cache_dir) if cache_dir is not None else reference_cache_dir()
@@ -221,7 +236,7 @@ def study_numbers(
             except ValueError:  # settings no room can be built from: the row says "not measured"
                 continue
             settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
-            reference = random_reference(room, settings)
+            reference = random_reference(room, settings, progress, label=group)
             _keep(cached, reference)
         numbers[group] = study_summary(tests, reference)
         numbers[group]["reference_commands_per_ring"] = commands_per_ring

@@ -204,7 +204,8 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
     return [
         [
             f"Competence, all rings, {label} (mean per-pixel max(0, 1 - agent / random); "
-            f"random reference of {commands} commands per ring, the study's "
+            f"random reference of {commands} commands per ring (the batch profile's "
+            "study_reference_commands, or --study-reference-commands), the study's "
             f"{RANDOM_COMMANDS_PER_RING}; 95% bias-corrected (BC) bootstrap intervals over "
             f"{BOOTSTRAP_SAMPLES} resamples of the runs, given where the tests cover "
             f"{pct(FULL_COVERAGE)} of the disk's pixels or more and the estimate lies within "

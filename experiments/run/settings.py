@@ -159,7 +159,7 @@ def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialS
     config.json, overrides included. `given` holds the settings the user gave explicitly;
     each must match the stored one, except a larger `iterations`, which extends the trial.
     TrialError, one line: no trial to resume in `out_dir`, or every mismatch at once."""
-    names = [f.name for f in dataclasses.fields(TrialSettings) if f.name != "overrides"]
+    names = [f.name for f in dataclasses.fields(TrialSettings)]
     unknown = sorted(set(given) - set(names))
     if unknown:
         raise TrialError(f"unknown trial settings {unknown}: one of {', '.join(names)}")
@@ -169,6 +169,8 @@ def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialS
     for name, value in given.items():
         have = getattr(stored, name)
         option = "--" + name.replace("_", "-")  # as `playroom run` names it
+        if name == "overrides":
+            option = "--set"
         if name == "iterations" and value < have:
             mismatches.append(f"{option} {value} (it has {have}; only a larger number extends it)")
         elif name != "iterations" and value != have:

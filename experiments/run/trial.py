@@ -205,9 +205,15 @@ class Trial:
         storage.write_json(config_path, self.config)
 
     # The loop -----------------------------------------------------------------------------
-    def run(self, progress: bool = True) -> None:
-        """Run until `iterations`, checkpointing every `checkpoint_every` iterations."""
+    def run(
+        self, progress: bool = True, report: Callable[[int], None] | None = None, every: int = 100
+    ) -> None:
+        """Run until `iterations`, checkpointing every `checkpoint_every` iterations; `report`
+        is told the iteration reached every `every` iterations and at the end (a batch's
+        progress, experiments/batches/progress.py)."""
         total = self.settings.iterations
+        if report is not None:  # running from here: where a resumed trial starts
+            report(self.iteration)
         # `with`: the bar's line is ended however the run ends (Ctrl-C, disk full), before
         # the command's last line.
         with tqdm(
@@ -218,10 +224,14 @@ class Trial:
             desc=f"{self.settings.grasp} seed {self.settings.seed}",
             dynamic_ncols=True,
         ) as bar:
-            self._run_to(total, bar)
+            self._run_to(total, bar, report, every)
             bar.set_postfix(self.counts)
+        if report is not None and self.iteration % every != 0:  # the end, if not yet told
+            report(self.iteration)
 
-    def _run_to(self, total: int, bar: tqdm) -> None:
+    def _run_to(
+        self, total: int, bar: tqdm, report: Callable[[int], None] | None, every: int
+    ) -> None:
         """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
         if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
             # A checkpoint before the first log chunk: a directory with logs then always has
@@ -238,6 +248,8 @@ class Trial:
             bar.update(1)
             if self.iteration % 50 == 0:
                 bar.set_postfix(self.counts, refresh=False)
+            if report is not None and self.iteration % every == 0:
+                report(self.iteration)
             if self.iteration % self.settings.checkpoint_every == 0 or self.iteration == total:
                 self._write_logs(chunk_start, rows, word_rows)
                 self._save_checkpoint()
@@ -276,9 +288,12 @@ def run_trial(
     resume: bool = False,
     progress: bool = True,
     notify: Callable[[str], None] | None = None,
+    report: Callable[[int], None] | None = None,
+    report_every: int = 100,
 ) -> Trial:
     """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
-    the run, with each line a resume has to report (a fallback checkpoint, an extension)."""
+    the run, with each line a resume has to report (a fallback checkpoint, an extension);
+    `report` with the iteration reached, every `report_every` iterations and at the end."""
     trial = Trial(out_dir, settings, resume=resume)
     if notify is not None:
         for notice in trial.notices:
@@ -288,7 +303,7 @@ def run_trial(
             return trial
         trial.start_iteration = trial.iteration
         start = time.perf_counter()
-        trial.run(progress=progress)
+        trial.run(progress=progress, report=report, every=report_every)
         trial.elapsed = time.perf_counter() - start
     finally:
         trial.close()

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from tqdm import tqdm
 
 from experiments.video.encoding import FrameEncoder, mux_into_place
 from experiments.video.overlay import Caption, Overlay
@@ -243,6 +244,7 @@ def render_random(
     shadows: bool = False,
     voice: str = DEFAULT_TRACT,
     sound: bool = False,
+    progress: bool | None = None,
 ) -> Path:
     """Film `iterations` random commands (half arm, half voice, in a seeded random order) in a
     new room and write the MP4 with overlay and sound to `out_path`.
@@ -251,7 +253,8 @@ def render_random(
     the movement's start; word_audio(word) -> (waveform, rate Hz): the caregiver's word, placed
     at the step she says it. None: silent, unless `sound`, which takes both from the room's
     vocal tract. voice: the tract (models/tracts.py). shadows: see `FrameRecorder`. Every
-    argument is checked before anything renders.
+    argument is checked before anything renders. progress: a bar on stderr (None: only on a
+    terminal).
     """
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations <= 0:
         raise ValueError(f"iterations must be a positive integer, got {iterations!r}")
@@ -265,7 +268,8 @@ def render_random(
     spaces = ["arm"] * math.ceil(iterations / 2) + ["voice"] * (iterations // 2)
     spaces = [spaces[k] for k in rng.permutation(iterations)]
     with EpisodeRenderer(size, fps, camera, lead_frames, hold_frames, shadows=shadows) as renderer:
-        for space in spaces:
+        disable = None if progress is None else not progress
+        for space in tqdm(spaces, disable=disable, desc="render", unit="iteration"):
             m = rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM)
             film_iteration(renderer, room, space, m, voice_audio, word_audio, model="random")
         return renderer.write(out)

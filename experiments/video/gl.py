@@ -19,6 +19,13 @@ RENDER_BACKENDS = ("egl", "osmesa", "glfw")
 DEFAULT_RENDER_BACKEND = "egl"
 # The value under which MuJoCo and dm_control load no GL library at all.
 NO_BACKEND = "disable"
+# The system library PyOpenGL loads for a backend (its ctypes name) and the packages that
+# provide it: a backend whose library is absent is named in one line, not as PyOpenGL's
+# "'NoneType' object has no attribute 'glGetError'". GLFW's wheel carries its own library.
+SYSTEM_LIBRARIES = {
+    "egl": ("EGL", "libegl1 (Debian/Ubuntu) or mesa-libEGL (Fedora)"),
+    "osmesa": ("OSMesa", "libosmesa6 (Debian/Ubuntu) or mesa-libOSMesa (Fedora)"),
+}
 
 
 class GLError(Exception):
@@ -36,12 +43,44 @@ def without_rendering() -> None:
         os.environ.setdefault(VARIABLE, NO_BACKEND)
 
 
+def for_viewing() -> None:
+    """For the interactive viewer (`playroom view`): GLFW, which opens windows; GLError if the
+    user chose another backend or mujoco was imported with one."""
+    chosen = os.environ.setdefault(VARIABLE, "glfw").strip().lower()
+    if chosen != "glfw":
+        raise GLError(f"the viewer opens a window with GLFW: unset {VARIABLE} (it is {chosen!r})")
+    if "mujoco" in sys.modules:
+        import mujoco
+
+        loaded = getattr(getattr(mujoco, "GLContext", None), "__module__", "none")
+        if loaded.split(".")[-1] != "glfw":
+            raise GLError(f"mujoco was imported with another OpenGL backend ({loaded})")
+
+
+def missing_library(backend: str) -> str | None:
+    """The one-line message for a backend whose system library cannot be found, else None."""
+    import ctypes.util
+
+    if backend not in SYSTEM_LIBRARIES:
+        return None
+    name, packages = SYSTEM_LIBRARIES[backend]
+    if ctypes.util.find_library(name) is not None:
+        return None
+    return (
+        f"lib{name} not found ({VARIABLE}={backend}): install the system package {packages}, "
+        f"or {choices()}"
+    )
+
+
 def for_rendering() -> str:
     """For commands that render: choose the backend (EGL by default), load it, and return its
     name; GLError in one line if it cannot be loaded."""
     chosen = os.environ.setdefault(VARIABLE, DEFAULT_RENDER_BACKEND).strip().lower()
     if chosen not in RENDER_BACKENDS:
         raise GLError(f"{VARIABLE}={chosen!r} cannot render: {choices()}")
+    missing = missing_library(chosen)
+    if missing is not None:
+        raise GLError(missing)
     try:
         import mujoco
 

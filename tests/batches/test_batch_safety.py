@@ -48,6 +48,12 @@ TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_ev
         ({"overrides": {"sky": {}}}, "overrides must be an object"),
         ({"overrides": {"world": {"no_such_setting": 1}}}, "unknown settings no_such_setting"),
         ({"description": 5}, "description must be a string"),
+        ({"study_reference_commands": 0}, "study_reference_commands must be a positive integer"),
+        ({"study_reference_commands": 3.5}, "study_reference_commands must be a positive integer"),
+        ({"study_reference_commands": "300"}, "study_reference_commands must be a positive"),
+        ({"base": "nope"}, "base must be the name of a stored profile (comparison, demo"),
+        ({"base": 1}, "base must be the name of a stored profile"),
+        ({"base": "smoke", "iterations": 0}, "iterations must be a positive integer"),
         ({"sede": 3}, "unknown field(s) sede"),
         ([{"seeds": 2}], "must hold a JSON object"),
     ],
@@ -165,7 +171,7 @@ def test_a_real_scheduler_passes_the_check():
 _started, _release = threading.Event(), threading.Event()
 
 
-def _held_task(trial_dir, settings, eval_placements, topic=None) -> dict:
+def _held_task(trial_dir, settings, eval_placements, *reporting) -> dict:
     _started.set()
     _release.wait(60)
     return {}
@@ -201,3 +207,44 @@ def test_a_lost_scheduler_ends_the_batch_in_one_line_that_says_how_to_resume(tmp
     assert "lost the Dask scheduler" in message and "\n" not in message
     assert "run the same command again" in message and "resume from their checkpoints" in message
     assert os.path.isdir(tmp_path / "out")
+
+
+def test_a_config_on_a_base_profile_changes_only_what_it_names(tmp_path):
+    path = tmp_path / "ablation.json"
+    path.write_text(
+        json.dumps(
+            {
+                "base": "replication",
+                "seeds": 2,
+                "overrides": {"learner": {"exploration_sigma": 0.05}},
+            }
+        )
+    )
+    spec, base = load_spec(config_file=path), load_spec("replication")
+    assert spec.seeds == (0, 1) and spec.overrides == {"learner": {"exploration_sigma": 0.05}}
+    assert spec.description == ""  # the base's own words describe the base, not this
+    same = ("grasps", "babbling", "iterations", "checkpoint_every", "eval_placements", "preset")
+    assert all(getattr(spec, f) == getattr(base, f) for f in same)
+
+
+def test_batch_set_merges_into_the_specs_overrides_and_is_checked(tmp_path, capsys):
+    from experiments.batches.spec import with_overrides
+    from experiments.cli.overrides import dotted_setting, merged
+
+    spec = BatchSpec(overrides={"learner": {"exploration_sigma": 0.05}})
+    sets = [
+        dotted_setting("world.catch_rule=held_stick"),
+        dotted_setting("learner.clip_sensory=false"),
+    ]
+    changed = with_overrides(spec, merged(spec.overrides, sets))
+    assert changed.overrides == {
+        "learner": {"exploration_sigma": 0.05, "clip_sensory": False},
+        "world": {"catch_rule": "held_stick"},
+    }
+    assert spec.overrides == {"learner": {"exploration_sigma": 0.05}}  # left as it was
+    out = tmp_path / "out"
+    args = ["batch", "--profile", "smoke", "--out", str(out)]
+    assert main([*args, "--set", "learner.exploration_sigma=-1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("playroom batch: error: --set: ") and "exploration_sigma" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()

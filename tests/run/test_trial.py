@@ -137,23 +137,25 @@ def test_directory_with_a_trial_is_refused_without_resume(tmp_path):
     _arrays_equal(before, storage.read_arrays(out / CHECKPOINT_FILE)[0])
 
 
-def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys):
+def test_bad_arguments_exit_2_with_argparses_usage_or_one_line(tmp_path, capsys):
     a_file = tmp_path / "file"
     a_file.write_text("x")
-    cases = [
+    # argparse's own errors: the command's usage line, then the error (issue 21).
+    parsing = [
         ["run", "--out", str(tmp_path / "a"), "--iterations", "0"],
         ["run", "--out", str(tmp_path / "a"), "--iterations", "-5"],
         ["run", "--out", str(tmp_path / "a"), "--grasp", "magnetic"],
         ["run", "--out", str(tmp_path / "a"), "--frobnicate"],
-        ["run", "--out", str(a_file), "--iterations", "5"],
     ]
-    for argv in cases:
-        with pytest.raises(SystemExit) as exc:
-            code = main(argv)
-            raise SystemExit(code)
-        assert exc.value.code == 2, argv
-        err = capsys.readouterr().err
-        assert len(err.strip().splitlines()) == 1, err
+    for argv in parsing:
+        assert main(argv) == 2, argv
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert lines[0].startswith("usage: playroom run "), lines
+        assert lines[-1].startswith("playroom run: error: "), lines
+    # The command's own refusals: one line.
+    assert main(["run", "--out", str(a_file), "--iterations", "5"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
     assert a_file.read_text() == "x"
 
 

@@ -107,3 +107,45 @@ def test_importing_the_packages_leaves_the_environment_alone():
     result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "None"
+
+
+def test_using_sim_on_a_headless_machine_prints_nothing():
+    # dm_control tries GLFW when MUJOCO_GL is unset; without a display GLFW used to warn
+    # "The DISPLAY environment variable is missing" on every import of the room.
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY")}
+    code = "import sim; sim.Playroom('kinematic').act_arm([0.1] * 21)"
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+
+
+def test_a_missing_gl_library_is_named_with_its_package(monkeypatch):
+    import ctypes.util
+
+    from experiments.video import gl
+
+    real = ctypes.util.find_library
+    monkeypatch.setattr(
+        ctypes.util, "find_library", lambda name: None if name == "OSMesa" else real(name)
+    )
+    monkeypatch.setenv(gl.VARIABLE, "osmesa")
+    with pytest.raises(gl.GLError) as caught:
+        gl.for_rendering()
+    message = str(caught.value)
+    assert message.startswith("libOSMesa not found")
+    assert "libosmesa6" in message and "mesa-libOSMesa" in message and "\n" not in message
+
+
+@pytest.mark.skipif(
+    __import__("ctypes.util").util.find_library("OSMesa") is not None,
+    reason="libOSMesa is installed here: nothing is missing",
+)
+def test_render_with_osmesa_absent_is_one_line_naming_the_package(tmp_path):
+    env = dict(os.environ, MUJOCO_GL="osmesa")
+    result = _playroom(env, "render", "--random", "--out", str(tmp_path / "v.mp4"), cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        "playroom render: error: libOSMesa not found (MUJOCO_GL=osmesa): install the system "
+        "package libosmesa6 (Debian/Ubuntu) or mesa-libOSMesa (Fedora), or set MUJOCO_GL to one "
+        "of egl, osmesa, glfw"
+    ]

@@ -1,0 +1,45 @@
+"""`--set section.name=value`: one setting of the world or the learner changed from the
+command line (`playroom run`, `playroom batch`), as a batch config's "overrides" change it.
+
+The value is read as JSON when it is JSON (0.05, true, [1, 2], "text"), else taken as a string
+(`--set world.stick_return=never` needs no quotes). Only the form is checked here: the names
+and values are checked by the configs, as every override is (experiments/run/settings.py)."""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+from typing import Any
+
+# The sections an override may change (experiments/run/settings.py OVERRIDABLE).
+SECTIONS = ("world", "learner")
+
+
+def dotted_setting(text: str) -> tuple[str, str, Any]:
+    """argparse type of `--set`: 'learner.exploration_sigma=0.05' -> ('learner',
+    'exploration_sigma', 0.05)."""
+    target, equals, raw = text.partition("=")
+    section, dot, name = target.strip().partition(".")
+    if not equals or not dot or not name.isidentifier():
+        raise argparse.ArgumentTypeError(
+            f"expected SECTION.NAME=VALUE (e.g. learner.exploration_sigma=0.05), got {text!r}"
+        )
+    if section not in SECTIONS:
+        raise argparse.ArgumentTypeError(
+            f"unknown section {section!r} in {text!r}: one of {', '.join(SECTIONS)}"
+        )
+    try:
+        value = json.loads(raw)
+    except json.JSONDecodeError:
+        value = raw  # a bare word: a string
+    return section, name, value
+
+
+def merged(overrides: dict, settings: list[tuple[str, str, Any]] | None) -> dict:
+    """`overrides` ({"world": {...}, "learner": {...}}) with each `--set` applied in order
+    (a later one wins); a new dict, the given one left as it is."""
+    out = copy.deepcopy(overrides)
+    for section, name, value in settings or []:
+        out.setdefault(section, {})[name] = value
+    return out

@@ -1,0 +1,118 @@
+"""`playroom view`: the room in MuJoCo's own interactive viewer (`mujoco.viewer.launch_passive`),
+live, at the room's real pace (one control step is 20 ms of simulated time): a trial replayed
+from its start (exactly, as videos replay it: experiments/video/replay.py), or random commands
+in a new room. It needs a display; the OpenGL backend is GLFW (`gl.for_viewing`)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+
+from experiments import storage
+from experiments.config_file import with_added_settings
+from experiments.file_names import CONFIG_FILE
+from experiments.run.trial_files import fresh_trial_parts
+from models.layout import ARM_DIM, VOICE_DIM
+from models.presets import DEFAULT_PRESET
+from sim import Playroom
+from sim.config import world_preset
+from sim.physics import CONTROL_SUBSTEPS
+
+
+class ViewError(Exception):
+    """What the user asked cannot be viewed; the message says why, in one line."""
+
+
+def display_missing() -> str | None:
+    """Why no window can open here (one line), or None where a display is set (macOS and
+    Windows always have one)."""
+    if sys.platform != "linux" or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return None
+    return (
+        "a display is needed (neither DISPLAY nor WAYLAND_DISPLAY is set); on a "
+        "machine without one, film the trial instead: playroom render"
+    )
+
+
+def _watching(room: Playroom, viewer, pace: float) -> Callable[[int, dict], None]:
+    """A step observer that shows each control step and keeps to `pace` x real time."""
+    step_s = room.physics.model.opt.timestep * CONTROL_SUBSTEPS / pace
+    clock = {"next": time.perf_counter()}
+
+    def observe(step: int, observation: dict) -> None:
+        if not viewer.is_running():  # closed: the movement ends unseen, then the command
+            return
+        viewer.sync()
+        clock["next"] += step_s
+        time.sleep(max(0.0, clock["next"] - time.perf_counter()))
+
+    return observe
+
+
+# How long to wait for the viewer's window to close after the last iteration (s).
+CLOSE_WAIT_S = 10
+
+
+@contextlib.contextmanager
+def _launch(room: Playroom) -> Iterator:
+    """The passive viewer of the room, closed on leaving: its window's thread is waited for,
+    since GLFW is terminated at exit and would pull the window from under a running thread
+    (a segmentation fault at the command's end)."""
+    import mujoco.viewer
+
+    before = set(threading.enumerate())
+    handle = mujoco.viewer.launch_passive(
+        room.physics.model.ptr, room.physics.data.ptr, show_left_ui=False, show_right_ui=False
+    )
+    window_threads = set(threading.enumerate()) - before
+    try:
+        yield handle
+    finally:
+        handle.close()
+        for thread in window_threads:
+            thread.join(CLOSE_WAIT_S)
+
+
+def view_random(grasp: str, seed: int, iterations: int, voice: str, pace: float = 1.0) -> int:
+    """Random commands (arm or voice, 1/2 each) in a new room, shown live; returns how many
+    were shown (fewer if the window was closed)."""
+    room = Playroom(grasp=grasp, seed=seed, config=world_preset(DEFAULT_PRESET, voice=voice))
+    rng = np.random.default_rng([seed, 1])  # a stream apart from the room's own
+    with _launch(room) as viewer:
+        room.step_observers.append(_watching(room, viewer, pace))
+        for shown in range(iterations):
+            if not viewer.is_running():
+                return shown
+            space = "arm" if rng.random() < 0.5 else "voice"
+            room.act(space, rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM))
+    return iterations
+
+
+def view_trial(trial_dir: str | os.PathLike, start: int, count: int, pace: float = 1.0) -> int:
+    """A trial's iterations `start` .. `start + count - 1`, shown live after replaying the
+    earlier ones unseen (the replay is exact: the same agent, the same room, the same draws);
+    returns how many were shown."""
+    path = Path(trial_dir) / CONFIG_FILE
+    if not path.is_file():
+        raise ViewError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    config = with_added_settings(storage.read_json(path))
+    total = int(config["trial"]["iterations"])
+    if not 0 <= start < total:
+        raise ViewError(f"--from {start} is out of range: the trial has 0..{total - 1}")
+    agent, room = fresh_trial_parts(config)
+    for _ in range(start):
+        agent.play(room)
+    with _launch(room) as viewer:
+        room.step_observers.append(_watching(room, viewer, pace))
+        for shown in range(min(count, total - start)):
+            if not viewer.is_running():
+                return shown
+            agent.play(room)
+    return min(count, total - start)
