@@ -25,6 +25,8 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import provenance, storage
+from experiments.analysis.log_chunks import chunk_path
+from experiments.analysis.logs import SOURCE_COLUMNS, source_of
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
@@ -40,10 +42,13 @@ from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, prepare_resume
 from experiments.run.trial_files import (
     EXTENSIBLE,
+    LEARNER_COLUMNS,
+    LEARNER_DTYPE,
     WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
     fresh_trial_parts,
+    learner_row,
     log_row,
     trial_identity,
 )
@@ -59,6 +64,7 @@ class Trial:
         self.settings = settings
         self.config = full_config(settings)
         self.identity = trial_identity(self.config)  # carried by every checkpoint
+        self.source = source_of(self.dir, self.config)  # first in every log row
         self.notices: list[str] = []  # one line each: what a resume had to do
         self._refuse_foreign_path()
         try:
@@ -244,6 +250,7 @@ class Trial:
                 rows, word_rows, chunk_start = [], [], self.iteration
 
     def _iterate(self) -> dict:
+        interests = self.agent.interests()  # what this iteration's model was chosen from
         proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
             sound = feedback.s[block_slice("sound")]
@@ -254,6 +261,7 @@ class Trial:
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
         self.counts["stick_returns"] += row["stick_returned"]
+        row.update(learner_row(proposal, self.agent.outcome(proposal, feedback.s), interests))
         return row
 
     def _word_row(self) -> dict:
@@ -264,10 +272,20 @@ class Trial:
         return row
 
     def _write_logs(self, start: int, rows: list[dict], word_rows: list[dict]) -> None:
-        log = self.dir / LOG_DIR
-        storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
+        iterations = pd.DataFrame(rows).astype(dict.fromkeys(LEARNER_COLUMNS, LEARNER_DTYPE))
+        self._write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
         if word_rows:
-            storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+            self._write_chunk("words", start, pd.DataFrame(word_rows))
+
+    def _write_chunk(
+        self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
+    ) -> None:
+        """One chunk of a log, in its kind's folder, its source columns first."""
+        for position, column in enumerate(SOURCE_COLUMNS):
+            table.insert(position, column, self.source[column])
+        path = chunk_path(self.dir, kind, start)
+        path.parent.mkdir(exist_ok=True)
+        storage.write_table(path, table, plain=plain)
 
 
 def run_trial(
