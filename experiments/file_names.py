@@ -23,6 +23,10 @@ LOG_KINDS = ("iterations", "words")
 LOG_CHUNK_PREFIX = "chunk-"
 # Trials written before the kinds had folders hold log/iterations-NNNNNNNN.parquet and
 # log/words-NNNNNNNN.parquet side by side: read as they are, moved into the folders on resume.
+# A text file in LOG_DIR, beside the kinds' folders: it says which folder to read, and a reader
+# of the whole of LOG_DIR (`pd.read_parquet("TRIAL/log")`) stops on it, naming it, instead of
+# mixing the two kinds' rows.
+LOG_README_FILE = "README.txt"
 OLD_LOG_CHUNK_PATTERN = r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parquet"
 # Where the machine, libraries and commit of each stretch of iterations are recorded
 # (experiments/provenance.py), and where one that cannot be read is kept aside.

@@ -33,6 +33,7 @@ from experiments.file_names import (
     CONFIG_FILE,
     LOCK_FILE,
     LOG_DIR,
+    LOG_README_FILE,
     PREVIOUS_CHECKPOINT_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
@@ -44,6 +45,7 @@ from experiments.run.trial_files import (
     EXTENSIBLE,
     LEARNER_COLUMNS,
     LEARNER_DTYPE,
+    LOG_README,
     WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
@@ -83,6 +85,9 @@ class Trial:
             self.start_iteration = 0
             if resume:
                 self._resume()
+            readme = self.dir / LOG_DIR / LOG_README_FILE
+            if not readme.exists():  # a new trial's, or an old one's moved into the folders
+                storage.write_text(readme, LOG_README)
             if not self.finished:  # who computes from here on (provenance.json)
                 self.notices += provenance.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()

@@ -7,7 +7,7 @@
   finds one stops, names it, and changes nothing.
 - Temporary files of writers killed mid-write are litter, removed by a resume, never results.
 - Logs of the old layout (chunks of both kinds side by side in log/) are read as they are, and
-  moved into their kinds' folders by a resume, one rename per chunk.
+  brought into their kinds' folders by a resume (experiments/run/old_logs.py).
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ from experiments.analysis.log_chunks import (
     DuplicateChunkError,
     chunk_path,
     chunk_paths,
-    old_chunks,
 )
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
@@ -31,6 +30,7 @@ from experiments.file_names import (
     LOG_KINDS,
     PREVIOUS_CHECKPOINT_FILE,
 )
+from experiments.run.old_logs import move_old_chunks
 from experiments.run.trial_files import (
     WORDS_LOG_PERIOD,
     TrialError,
@@ -236,28 +236,13 @@ def prepare_resume(
         notices.append(
             f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
         )
-    moved = move_old_chunks(trial_dir)
+    moved = move_old_chunks(trial_dir, config)
     if moved:
         notices.append(
             f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
             "log/words-*.parquet) into log/iterations/ and log/words/"
         )
     return restored
-
-
-def move_old_chunks(trial_dir: Path) -> int:
-    """Move the log chunks of the old layout (side by side in log/) into their kinds' folders
-    (log/iterations/, log/words/), each by one rename: a move killed at any moment leaves
-    every chunk in one layout or the other, which both readers read, and the next resume
-    moves the rest. Returns how many were moved. Called under the directory's lock, after
-    the logs were checked (a chunk in both layouts stops that check)."""
-    moved = 0
-    for kind, start, path in old_chunks(trial_dir):
-        target = chunk_path(trial_dir, kind, start)
-        target.parent.mkdir(exist_ok=True)
-        os.replace(path, target)
-        moved += 1
-    return moved
 
 
 def drop_logs_past(trial_dir: Path, iteration: int) -> None:

@@ -13,6 +13,7 @@ A trial directory holds:
   every row of both carries its source (trial, seed, backend, voice); the columns are listed in
   experiments/analysis/logs.py, which reads them back (trials of the old layout too:
   log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
+- `log/README.txt`: which folder of log/ to read (a reader of all of log/ stops on it);
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
   iterations, one entry per run or resume (experiments/provenance.py);
 - `.lock`: the lock of its one writer (experiments/run/lock.py).
@@ -44,6 +45,18 @@ from sim.vocal.config import VoiceConfig
 # Iterations between two rows of the words log: the vocal learning curves are read every 100
 # iterations (docs/protocol.md §10).
 WORDS_LOG_PERIOD = 100
+
+# What log/README.txt says (experiments/file_names.py: why it is there).
+LOG_README = """\
+This folder holds a trial's logs, one folder per kind, one Parquet chunk per checkpoint period:
+  iterations/  one row per iteration          pd.read_parquet("TRIAL/log/iterations")
+  words/       every 100 iterations, the best distance reached so far to each word
+                                              pd.read_parquet("TRIAL/log/words")
+The kinds have different rows: read one of the folders, not this one (this file stops a reader
+of the whole folder before it mixes them). Every row names its trial, seed, backend and voice.
+With the project installed: `from experiments.logs import read_log, read_batch_logs`; the
+columns are described in experiments/analysis/logs.py.
+"""
 
 # The learner's columns of the iterations log: the goal and the outcome in the chosen model's
 # sensory block, and every model's interest (experiments/analysis/logs.py says what each holds).
