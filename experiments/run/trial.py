@@ -50,7 +50,7 @@ from experiments.run.trial_files import (
     TrialError,
     TrialLocked,
     fresh_trial_parts,
-    learner_row,
+    learner_values,
     log_row,
     trial_identity,
 )
@@ -238,7 +238,7 @@ class Trial:
             # A checkpoint before the first log chunk: a directory with logs then always has
             # a checkpoint, unless it was lost, and a resume can tell which (`_resume`).
             self._save_checkpoint()
-        rows: list[dict] = []
+        rows: list[tuple[dict, np.ndarray]] = []
         word_rows: list[dict] = []
         chunk_start = self.iteration
         while self.iteration < total:
@@ -254,7 +254,8 @@ class Trial:
                 self._save_checkpoint()
                 rows, word_rows, chunk_start = [], [], self.iteration
 
-    def _iterate(self) -> dict:
+    def _iterate(self) -> tuple[dict, np.ndarray]:
+        """One iteration: its row of events (`log_row`) and its learner's values."""
         interests = self.agent.interests()  # what this iteration's model was chosen from
         proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
@@ -266,8 +267,7 @@ class Trial:
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
         self.counts["stick_returns"] += row["stick_returned"]
-        row.update(learner_row(proposal, self.agent.outcome(proposal, feedback.s), interests))
-        return row
+        return row, learner_values(proposal, self.agent.outcome(proposal, feedback.s), interests)
 
     def _word_row(self) -> dict:
         row: dict[str, float] = {"iteration": self.iteration}
@@ -276,8 +276,13 @@ class Trial:
             row[word] = float(best)
         return row
 
-    def _write_logs(self, start: int, rows: list[dict], word_rows: list[dict]) -> None:
-        iterations = pd.DataFrame(rows).astype(dict.fromkeys(LEARNER_COLUMNS, LEARNER_DTYPE))
+    def _write_logs(
+        self, start: int, rows: list[tuple[dict, np.ndarray]], word_rows: list[dict]
+    ) -> None:
+        events = pd.DataFrame([row for row, _ in rows])
+        values = np.vstack([v for _, v in rows]).astype(LEARNER_DTYPE)
+        learner = pd.DataFrame(values, columns=list(LEARNER_COLUMNS))
+        iterations = pd.concat([events, learner], axis=1)
         self._write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
         if word_rows:
             self._write_chunk("words", start, pd.DataFrame(word_rows))

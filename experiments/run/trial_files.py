@@ -67,7 +67,7 @@ LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
 # Stored as float32: 7 significant digits are plenty to plot and average them, at half the size
 # of float64 (random goals hardly compress). The other columns keep their types.
 LEARNER_DTYPE = np.float32
-_NO_BLOCK = (float("nan"),) * BLOCK_DIM
+_NO_BLOCK = np.full(BLOCK_DIM, np.nan)
 
 # Settings a resume may change: a trial can be extended to more iterations.
 EXTENSIBLE = ("trial.iterations",)
@@ -130,20 +130,20 @@ def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
     return row
 
 
-def learner_row(
+def learner_values(
     proposal: Proposal, reached: np.ndarray | None, interests: np.ndarray
-) -> dict[str, float]:
-    """The learner's columns of an iteration's row: the goal (NaN without one: the bootstrap's
-    random motor babbling), the outcome in the goal's block (`Agent.outcome`, NaN without a
-    model) and each model's interest when the model was chosen (`Agent.interests`, read
-    before the iteration's attempt)."""
-    goal = _NO_BLOCK if proposal.goal is None else proposal.goal.tolist()
-    outcome = _NO_BLOCK if reached is None else reached.tolist()
-    return {
-        **dict(zip(GOAL_COLUMNS, goal, strict=True)),
-        **dict(zip(REACHED_COLUMNS, outcome, strict=True)),
-        **dict(zip(INTEREST_COLUMNS, interests.tolist(), strict=True)),
-    }
+) -> np.ndarray:
+    """The learner's columns of an iteration's row (LEARNER_COLUMNS), (30,): the goal (NaN
+    without one: the bootstrap's random motor babbling), the outcome in the goal's block
+    (`Agent.outcome`, NaN without a model) and each model's interest when the model was
+    chosen (`Agent.interests`, read before the iteration's attempt)."""
+    return np.concatenate(
+        (
+            _NO_BLOCK if proposal.goal is None else proposal.goal,
+            _NO_BLOCK if reached is None else reached,
+            interests,
+        )
+    )
 
 
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
