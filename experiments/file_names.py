@@ -16,6 +16,18 @@ PREVIOUS_CHECKPOINT_FILE = "checkpoint.prev.npz"
 # Where a damaged newest checkpoint is kept when a resume falls back past it.
 DAMAGED_CHECKPOINT_FILE = "checkpoint.damaged.npz"
 LOG_DIR = "log"
+# The logs, each kind in its own folder of LOG_DIR, one chunk per checkpoint period:
+# log/iterations/chunk-NNNNNNNN.parquet and log/words/chunk-NNNNNNNN.parquet, NNNNNNNN the
+# iteration the chunk starts at, so that `pd.read_parquet("TRIAL/log/iterations")` reads one kind.
+LOG_KINDS = ("iterations", "words")
+LOG_CHUNK_PREFIX = "chunk-"
+# Trials written before the kinds had folders hold log/iterations-NNNNNNNN.parquet and
+# log/words-NNNNNNNN.parquet side by side: read as they are, moved into the folders on resume.
+# A text file in LOG_DIR, beside the kinds' folders: it says which folder to read, and a reader
+# of the whole of LOG_DIR (`pd.read_parquet("TRIAL/log")`) stops on it, naming it, instead of
+# mixing the two kinds' rows.
+LOG_README_FILE = "README.txt"
+OLD_LOG_CHUNK_PATTERN = r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parquet"
 # Where the machine, libraries and commit of each stretch of iterations are recorded
 # (experiments/provenance.py), and where one that cannot be read is kept aside.
 PROVENANCE_FILE = "provenance.json"
@@ -53,3 +65,12 @@ COMPARISON_FILE = "comparison.html"
 ABLATION_TABLE_FILE = "ablations.md"
 ABLATION_CSV_FILE = "ablations.csv"
 ABLATION_FIGURE_FILE = "ablations.png"
+# The numbers a report or comparison page shows, machine-readable, written with the page
+# (experiments/report/summary.py): nested JSON, and the same numbers as one long CSV table.
+SUMMARY_JSON_FILE = "summary.json"
+SUMMARY_CSV_FILE = "summary.csv"
+
+
+def log_chunk_name(start: int) -> str:
+    """The name of the log chunk that starts at iteration `start`, in its kind's folder."""
+    return f"{LOG_CHUNK_PREFIX}{start:08d}.parquet"

@@ -13,6 +13,7 @@ import math
 import os
 import re
 import zipfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -142,10 +143,15 @@ def json_bytes(obj: Any) -> bytes:
     return (json.dumps(obj, indent=2, sort_keys=True, allow_nan=False) + "\n").encode()
 
 
-def table_bytes(table: pd.DataFrame) -> bytes:
-    """`table` as Parquet (without its index)."""
+def table_bytes(table: pd.DataFrame, plain: Sequence[str] = ()) -> bytes:
+    """`table` as Parquet (without its index); the columns named in `plain` without a
+    dictionary (values that hardly repeat, such as random goals, only grow by one)."""
     buffer = io.BytesIO()
-    table.to_parquet(buffer, index=False)
+    if plain:
+        keep = [c for c in table.columns if c not in set(plain)]
+        table.to_parquet(buffer, index=False, use_dictionary=keep)
+    else:
+        table.to_parquet(buffer, index=False)
     return buffer.getvalue()
 
 
@@ -207,8 +213,9 @@ def read_arrays(path: Path) -> tuple[dict[str, np.ndarray], dict]:
     return arrays, meta
 
 
-def write_table(path: Path, table: pd.DataFrame) -> None:
-    write_bytes(path, table_bytes(table))
+def write_table(path: Path, table: pd.DataFrame, plain: Sequence[str] = ()) -> None:
+    """`table` as Parquet at `path`, atomically (`table_bytes` says what `plain` is)."""
+    write_bytes(path, table_bytes(table, plain))
 
 
 def read_table(path: Path) -> pd.DataFrame:

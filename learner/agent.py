@@ -168,7 +168,8 @@ class Agent:
                 self.models[k].store(m, context, s)
         if proposal.model is not None:
             assert proposal.goal is not None  # propose() gives every model's proposal a goal
-            reached = s[self.models[proposal.model].sensory_slice]
+            reached = self.outcome(proposal, s)
+            assert reached is not None  # a proposal with a model has an outcome
             self.interest.update(proposal.model, proposal.goal, reached)
         if proposal.motor_space == "arm":
             sound = s[self._sound_slice]
@@ -176,6 +177,24 @@ class Agent:
                 self._hear(sound)
         self.t += 1
         self._pending = None
+
+    def outcome(self, proposal: Proposal, s: ArrayLike) -> np.ndarray | None:
+        """What `proposal` reached (10,): the sensory block of its model (the block its goal
+        lies in) in the feedback s (60,), as the learner reads it (clipped to [-1, 1] under
+        `clip_sensory`); its competence is -|goal - outcome|. None for a proposal without a
+        model (bootstrap: random motor babbling)."""
+        if proposal.model is None:
+            return None
+        s = np.asarray(s, dtype=np.float64)
+        if self.config.clip_sensory:
+            s = s.clip(-1.0, 1.0)
+        return s[self.models[proposal.model].sensory_slice].copy()
+
+    def interests(self) -> np.ndarray:
+        """Each model's interest (n_models,): its learning progress (learner.interest), from
+        which the next model is chosen under active babbling (kept under random babbling
+        too, where it chooses nothing)."""
+        return self.interest.progress()
 
     # ------------------------------------------------------------------ evaluation
 

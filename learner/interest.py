@@ -69,13 +69,15 @@ class InterestModel:
         k = self._attempts[model]
         self._competences[model, k % (2 * self.window)] = value
         self._attempts[model] = k + 1
-        if self.mode == "active":  # only active choice reads it on every iteration
-            self._progress[model] = self._model_progress(model)
+        # Kept under random babbling too, where no choice reads it: the trial's log records
+        # every model's progress at every iteration (one model's update, not ten).
+        self._progress[model] = self._model_progress(model)
         return value
 
     def progress(self) -> np.ndarray:
-        """Progress of each model (n_models,), as defined in the module docstring."""
-        return np.array([self._model_progress(k) for k in range(self.n_models)])
+        """Progress of each model (n_models,), as defined in the module docstring: the
+        interest the next choice is drawn from under active babbling."""
+        return self._progress.copy()
 
     def _model_progress(self, model: int) -> float:
         n = int(self._attempts[model])

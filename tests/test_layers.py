@@ -18,6 +18,7 @@ SIMULATOR = ("mujoco", "dm_control", "numba", "sim", "learner")
         ("import experiments.analysis.results", SIMULATOR),
         ("import experiments.analysis.stats", SIMULATOR),
         ("import experiments.report.comparison", SIMULATOR),
+        ("from experiments.logs import read_log, read_batch_logs", SIMULATOR),
         # The parser reads the settings' allowed values from sim.config and learner.config.
         (
             "from experiments.cli.main import build_parser; build_parser()",

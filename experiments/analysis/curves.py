@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from experiments.analysis.logs import SOURCE_COLUMNS
+
 CURVE_POINTS = 40
 # Metric -> the column of movements it is a share of.
 RATES = {
@@ -68,7 +70,9 @@ def curve_rows(
                 )
     if not words.empty:
         # A word never approached has distance inf; it would make every mean inf.
-        values = words.drop(columns="iteration").replace(np.inf, np.nan)
+        # Every column but the iteration and the row's source is a word.
+        not_words = ["iteration", *SOURCE_COLUMNS]
+        values = words.drop(columns=not_words, errors="ignore").replace(np.inf, np.nan)
         for metric, chosen in (
             ("best_distance_names", [w for w in values.columns if w in names]),
             ("best_distance_distractors", [w for w in values.columns if w not in names]),

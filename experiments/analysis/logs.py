@@ -1,4 +1,35 @@
-"""A trial's logs, read back (experiments/run/trial_files.py says what a row holds)."""
+"""A trial's logs, or a batch's, read back into one pandas DataFrame.
+
+    from experiments.logs import read_log, read_batch_logs
+    log = read_log("runs/demo/kinematic-random-seed0000")            # one row per iteration
+    words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
+
+Every row carries its source: `trial` (the trial directory's name), `seed`, `backend` (the
+grasp backend) and `voice` (the vocal tract), so that rows of several trials keep apart.
+Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
+`pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks'
+names, which is the iterations' order).
+
+The iterations log, one row per iteration (experiments/run/trial_files.py writes it):
+- iteration; motor_space ("arm" or "voice"); model (the chosen model, 0-based into
+  models.layout.MODELS, -1 during the bootstrap's random motor babbling);
+- stick_distance (m, the handle from the arm's base before the movement), stick_grasped,
+  stick_moved_by, toy1/2/3_moved_by ("hand", "stick", "push", "caregiver" or ""),
+  word_recognised, caregiver_said, diverged, stick_returned;
+- goal_0..goal_9: the sensory goal the agent chose, in its model's 10D block (5 samples of x
+  then 5 of y; for the sound, of F1 then F2); NaN during the bootstrap (no goal);
+- reached_0..reached_9: the outcome in that same block of the feedback, as the learner reads it
+  (clipped to [-1, 1] under the study preset), so that the attempt's competence is
+  -sqrt(sum((goal_i - reached_i)^2)); NaN during the bootstrap;
+- interest_0..interest_9: each model's interest (learning progress, learner/interest.py) when
+  the iteration's model was chosen, i.e. before this iteration's attempt; column k is model k
+  of `model`. Kept under random babbling too, where it chooses nothing.
+Goals, outcomes and interests are float32 (7 significant digits); rows written before they were
+logged hold NaN there.
+
+The words log, one row every 100 iterations: iteration and, per word, the best distance reached
+so far to it (inf before the voice was used).
+"""
 
 from __future__ import annotations
 
@@ -8,12 +39,63 @@ from pathlib import Path
 import pandas as pd
 
 from experiments import storage
-from experiments.file_names import LOG_DIR
+from experiments.analysis.log_chunks import check_kind, chunk_paths, is_trial_dir
+from experiments.config_file import with_added_settings
+from experiments.file_names import CONFIG_FILE
+
+# The columns that say which trial a row comes from, first in every row.
+SOURCE_COLUMNS = ("trial", "seed", "backend", "voice")
+
+
+def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
+    """The source columns of a trial's rows, from its directory and config."""
+    trial = config["trial"]
+    return {
+        "trial": Path(trial_dir).resolve().name,
+        "seed": int(trial["seed"]),
+        "backend": str(trial["grasp"]),
+        "voice": str(trial.get("voice", "vtl")),
+    }
 
 
 def read_log(trial_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:
-    """All chunks of one log ('iterations' or 'words') of a trial, in order."""
-    chunks = sorted((Path(trial_dir) / LOG_DIR).glob(f"{kind}-*.parquet"))
+    """All chunks of one log ('iterations' or 'words') of a trial, in order, each row with its
+    source columns (filled from config.json for logs written before rows carried them). An
+    empty DataFrame if the trial has no chunk of that kind yet. storage.CorruptFileError for a
+    chunk that cannot be read."""
+    check_kind(kind)
+    chunks = chunk_paths(trial_dir, kind)
     if not chunks:
         return pd.DataFrame()
-    return pd.concat([storage.read_table(c) for c in chunks], ignore_index=True)
+    frame = pd.concat([storage.read_table(c) for c in chunks.values()], ignore_index=True)
+    missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
+    config_path = Path(trial_dir) / CONFIG_FILE
+    if missing and config_path.exists():
+        source = source_of(trial_dir, with_added_settings(storage.read_json(config_path)))
+        for position, column in enumerate(SOURCE_COLUMNS):
+            if column in missing:
+                frame.insert(position, column, source[column])
+    return frame
+
+
+def trial_dirs(batch_dir: str | os.PathLike) -> list[Path]:
+    """The trial directories of a batch directory, by name."""
+    batch_dir = Path(batch_dir)
+    if not batch_dir.is_dir():
+        raise ValueError(f"{batch_dir} is not a directory")
+    return sorted(d for d in batch_dir.iterdir() if d.is_dir() and is_trial_dir(d))
+
+
+def read_batch_logs(batch_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:
+    """One log ('iterations' or 'words') of every trial of a batch directory in one DataFrame,
+    trial after trial (by directory name), each row with its source columns (trial, seed,
+    backend, voice). ValueError (one line) for a folder that holds no trial directory."""
+    check_kind(kind)
+    dirs = trial_dirs(batch_dir)
+    if not dirs:
+        raise ValueError(
+            f"no trial directories in {batch_dir}: a batch directory holds one folder per trial "
+            "(its config.json and log/), as `playroom batch --out DIR` writes them"
+        )
+    frames = [frame for frame in (read_log(d, kind) for d in dirs) if not frame.empty]
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()

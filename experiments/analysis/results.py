@@ -23,6 +23,7 @@ import pandas as pd
 
 from experiments import storage
 from experiments.analysis.curves import curve_rows, tool_numbers
+from experiments.analysis.log_chunks import is_trial_dir
 from experiments.analysis.logs import read_log
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
@@ -151,21 +152,15 @@ def _names(paths: list[Path], limit: int = 5) -> str:
     return shown + (f" and {len(paths) - limit} more" if len(paths) > limit else "")
 
 
-def _is_trial(directory: Path) -> bool:
-    """Whether a folder is a trial directory: `playroom run` writes its config.json and log/
-    (experiments/run/trial_files.py). Another tool's folder with a config.json is not one."""
-    return (directory / CONFIG_FILE).is_file() and (directory / LOG_DIR).is_dir()
-
-
 def _trial_dirs(batch_dir: Path) -> list[Path]:
     if not batch_dir.is_dir():
         raise ReportError(f"{batch_dir} is not a directory")
-    if _is_trial(batch_dir):
+    if is_trial_dir(batch_dir):
         raise ReportError(
             f"{batch_dir} is a trial directory, not a batch: give the folder that holds trial "
             f"directories (this one is in {batch_dir.resolve().parent})"
         )
-    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and _is_trial(d))
+    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and is_trial_dir(d))
     if not dirs:
         raise ReportError(
             f"no trial directories found in {batch_dir}: a batch directory holds one folder per "
@@ -234,7 +229,7 @@ def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
     if log.empty:
-        raise ReportError(f"{trial_dir.name} has no iteration log (log/iterations-*.parquet)")
+        raise ReportError(f"{trial_dir.name} has no iteration log ({LOG_DIR}/iterations/)")
     return log, words
 
 

@@ -22,6 +22,7 @@ from experiments.report import name_strategies, paper, tool_rule
 from experiments.report.figures import FigureFile, report_figures
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
+from experiments.report.summary import page_summary, summary_files
 
 
 def write_report(
@@ -30,7 +31,8 @@ def write_report(
     *,
     measures: RoomMeasures,
 ) -> Path:
-    """Figures (PNG) and `report.html` of a batch, its numbers beside the paper's; into
+    """Figures (PNG) and `report.html` of a batch, its numbers beside the paper's, with the
+    page's numbers in `summary.json` and `summary.csv` (experiments/report/summary.py); into
     `out_dir` (default: the batch directory). Returns the path of report.html. ReportError
     (one line) for a batch that cannot be reported on; nothing is written then.
     `measures`: the study's numbers, measured in rooms (experiments.measure.for_reports)."""
@@ -56,7 +58,10 @@ def write_report(
         **name_strategies.page_context(results, geometry.threshold),
         **tool_rule.page_context(results),
     )
-    return write_page(out, figures, REPORT_FILE, page)
+    content = page_summary(
+        results, numbers, published, page=REPORT_FILE, batches=[str(results.batch_dir)]
+    )
+    return write_page(out, figures, REPORT_FILE, page, beside=summary_files(content))
 
 
 def numbers_and_figures(

@@ -52,6 +52,7 @@ from experiments.report.pages import (
     where_table,
     write_page,
 )
+from experiments.report.summary import page_summary, summary_files
 
 # Random arm commands behind the comparison's stick-grasp rates of the two backends.
 GRASP_RATE_COMMANDS = 1000
@@ -266,7 +267,8 @@ def write_comparison(
     panel per batch, the paper table with both, tests of their differences and the cost per
     iteration of each, and the stick's numbers (with `grasp_rate_commands` random commands
     played in both backends). `dir_a` may equal `dir_b` for one batch of exactly two groups. Writes
-    `comparison.html` and `comparison-*.png` into out_dir; returns the page's path."""
+    `comparison.html`, `comparison-*.png` and the page's numbers (`summary.json`,
+    `summary.csv`: experiments/report/summary.py) into out_dir; returns the page's path."""
     dir_a, dir_b = Path(dir_a), Path(dir_b)
     a, b = _sides(dir_a, dir_b)
     check_out_dir(Path(out_dir))
@@ -275,6 +277,10 @@ def write_comparison(
     figures = [FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png) for f in page_figures]
     g = merged.groups
     where, where_note = where_table(merged)
+    tests = Table(
+        ["statistic", g[0], g[1], "test of the difference", "p (two-sided)"],
+        difference_rows(a, b, geometry, measures, grasp_rate_commands),
+    )
     page = render(
         "comparison.html.j2",
         title=f"Playroom comparison: {g[0]} vs {g[1]}",
@@ -285,10 +291,7 @@ def write_comparison(
         dirs=[str(d) for d in dict.fromkeys((dir_a, dir_b))],
         settings=settings_table(merged),
         configs=merged.configs,
-        tests=Table(
-            ["statistic", g[0], g[1], "test of the difference", "p (two-sided)"],
-            difference_rows(a, b, geometry, measures, grasp_rate_commands),
-        ),
+        tests=tests,
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),
         paper=published,
         reference=paper.reference(),
@@ -298,4 +301,12 @@ def write_comparison(
         **name_strategies.page_context(merged, geometry.threshold),
         **tool_rule.page_context(merged),
     )
-    return write_page(Path(out_dir), figures, COMPARISON_FILE, page)
+    content = page_summary(
+        merged,
+        numbers,
+        published,
+        page=COMPARISON_FILE,
+        batches=[str(d) for d in dict.fromkeys((dir_a, dir_b))],
+        tests=tests,
+    )
+    return write_page(Path(out_dir), figures, COMPARISON_FILE, page, summary_files(content))

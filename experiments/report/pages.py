@@ -236,10 +236,17 @@ def render(template: str, **context: Any) -> str:
     return _ENV.get_template(template).render(**context)
 
 
-def write_page(out_dir: Path, figures: list[FigureFile], page_name: str, page: str) -> Path:
-    """The PNGs and the page as one unit (`storage.write_files`), the page last: a write that
-    fails (disk full) leaves nothing, and a page on disk means its figures are there too.
-    Returns the page's path."""
+def write_page(
+    out_dir: Path,
+    figures: list[FigureFile],
+    page_name: str,
+    page: str,
+    beside: dict[str, bytes] | None = None,
+) -> Path:
+    """The PNGs, the files `beside` it (its summary) and the page as one unit
+    (`storage.write_files`), the page last: a write that fails (disk full) leaves nothing,
+    and a page on disk means its figures and summary are there too. Returns the page's path."""
     files = {figure.name: figure.png for figure in figures}
+    files.update(beside or {})
     files[page_name] = page.encode("utf-8")
     return storage.write_files(out_dir, files)[-1]

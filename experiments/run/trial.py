@@ -25,12 +25,15 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import provenance, storage
+from experiments.analysis.log_chunks import chunk_path
+from experiments.analysis.logs import SOURCE_COLUMNS, source_of
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     LOCK_FILE,
     LOG_DIR,
+    LOG_README_FILE,
     PREVIOUS_CHECKPOINT_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
@@ -40,10 +43,14 @@ from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, prepare_resume
 from experiments.run.trial_files import (
     EXTENSIBLE,
+    LEARNER_COLUMNS,
+    LEARNER_DTYPE,
+    LOG_README,
     WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
     fresh_trial_parts,
+    learner_values,
     log_row,
     trial_identity,
 )
@@ -59,6 +66,7 @@ class Trial:
         self.settings = settings
         self.config = full_config(settings)
         self.identity = trial_identity(self.config)  # carried by every checkpoint
+        self.source = source_of(self.dir, self.config)  # first in every log row
         self.notices: list[str] = []  # one line each: what a resume had to do
         self._refuse_foreign_path()
         try:
@@ -77,6 +85,9 @@ class Trial:
             self.start_iteration = 0
             if resume:
                 self._resume()
+            readme = self.dir / LOG_DIR / LOG_README_FILE
+            if not readme.exists():  # a new trial's, or an old one's moved into the folders
+                storage.write_text(readme, LOG_README)
             if not self.finished:  # who computes from here on (provenance.json)
                 self.notices += provenance.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()
@@ -237,7 +248,7 @@ class Trial:
             # A checkpoint before the first log chunk: a directory with logs then always has
             # a checkpoint, unless it was lost, and a resume can tell which (`_resume`).
             self._save_checkpoint()
-        rows: list[dict] = []
+        rows: list[tuple[dict, np.ndarray]] = []
         word_rows: list[dict] = []
         chunk_start = self.iteration
         while self.iteration < total:
@@ -255,7 +266,9 @@ class Trial:
                 self._save_checkpoint()
                 rows, word_rows, chunk_start = [], [], self.iteration
 
-    def _iterate(self) -> dict:
+    def _iterate(self) -> tuple[dict, np.ndarray]:
+        """One iteration: its row of events (`log_row`) and its learner's values."""
+        interests = self.agent.interests()  # what this iteration's model was chosen from
         proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
             sound = feedback.s[block_slice("sound")]
@@ -266,7 +279,7 @@ class Trial:
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
         self.counts["stick_returns"] += row["stick_returned"]
-        return row
+        return row, learner_values(proposal, self.agent.outcome(proposal, feedback.s), interests)
 
     def _word_row(self) -> dict:
         row: dict[str, float] = {"iteration": self.iteration}
@@ -275,11 +288,26 @@ class Trial:
             row[word] = float(best)
         return row
 
-    def _write_logs(self, start: int, rows: list[dict], word_rows: list[dict]) -> None:
-        log = self.dir / LOG_DIR
-        storage.write_table(log / f"iterations-{start:08d}.parquet", pd.DataFrame(rows))
+    def _write_logs(
+        self, start: int, rows: list[tuple[dict, np.ndarray]], word_rows: list[dict]
+    ) -> None:
+        events = pd.DataFrame([row for row, _ in rows])
+        values = np.vstack([v for _, v in rows]).astype(LEARNER_DTYPE)
+        learner = pd.DataFrame(values, columns=list(LEARNER_COLUMNS))
+        iterations = pd.concat([events, learner], axis=1)
+        self._write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
         if word_rows:
-            storage.write_table(log / f"words-{start:08d}.parquet", pd.DataFrame(word_rows))
+            self._write_chunk("words", start, pd.DataFrame(word_rows))
+
+    def _write_chunk(
+        self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
+    ) -> None:
+        """One chunk of a log, in its kind's folder, its source columns first."""
+        for position, column in enumerate(SOURCE_COLUMNS):
+            table.insert(position, column, self.source[column])
+        path = chunk_path(self.dir, kind, start)
+        path.parent.mkdir(exist_ok=True)
+        storage.write_table(path, table, plain=plain)
 
 
 def run_trial(

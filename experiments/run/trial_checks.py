@@ -6,23 +6,31 @@
   chunk cannot be regenerated (except by running the trial again from scratch), so whatever
   finds one stops, names it, and changes nothing.
 - Temporary files of writers killed mid-write are litter, removed by a resume, never results.
+- Logs of the old layout (chunks of both kinds side by side in log/) are read as they are, and
+  brought into their kinds' folders by a resume (experiments/run/old_logs.py).
 """
 
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
 from experiments import storage
+from experiments.analysis.log_chunks import (
+    DuplicateChunkError,
+    chunk_path,
+    chunk_paths,
+)
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
     LOG_DIR,
+    LOG_KINDS,
     PREVIOUS_CHECKPOINT_FILE,
 )
+from experiments.run.old_logs import move_old_chunks
 from experiments.run.trial_files import (
     WORDS_LOG_PERIOD,
     TrialError,
@@ -31,9 +39,6 @@ from experiments.run.trial_files import (
 )
 from learner.agent import Agent
 from sim import Playroom
-
-# A log chunk: its kind and the iteration it starts at.
-_CHUNK = re.compile(r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parquet")
 
 
 def restore_newest(
@@ -84,10 +89,13 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
     return config, agent, room, meta
 
 
-def log_chunk_start(path: Path) -> int | None:
-    """The iteration a log chunk starts at; None if `path` is not named as a log chunk."""
-    match = _CHUNK.fullmatch(path.name)
-    return None if match is None else int(match["start"])
+def _chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
+    """The chunks of one kind of log, of both layouts (experiments/analysis/log_chunks.py);
+    TrialError for a chunk found in both."""
+    try:
+        return chunk_paths(trial_dir, kind)
+    except DuplicateChunkError as exc:
+        raise TrialError(f"{exc}; nothing was changed") from None
 
 
 def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
@@ -95,25 +103,26 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
     is missing, unreadable, or holds other rows than its name and period say: the iterations
     chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
     WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later
-    are work past the checkpoint (a resume rewrites them) and are not looked at."""
-    log = Path(trial_dir) / LOG_DIR
-    found: dict[str, dict[int, Path]] = {"iterations": {}, "words": {}}
-    for path in log.glob("*.parquet"):
-        match = _CHUNK.fullmatch(path.name)
-        if match is not None and int(match["start"]) < iteration:
-            found[match["kind"]][int(match["start"])] = path
+    are work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of
+    both layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
+    trial_dir = Path(trial_dir)
+    found = {
+        kind: {s: p for s, p in _chunks(trial_dir, kind).items() if s < iteration}
+        for kind in LOG_KINDS
+    }
     start = 0
     while start < iteration:
-        path = log / f"iterations-{start:08d}.parquet"
         if start not in found["iterations"]:
+            path = chunk_path(trial_dir, "iterations", start)
             end = min((s for s in found["iterations"] if s > start), default=iteration)
             raise TrialError(_lost(f"{path} is missing (iterations {start} to {end - 1})"))
+        path = found["iterations"][start]
         end = start + _check_rows(path, range(start, iteration), whole=False)
         # The words rows this period reached: the multiples of the period in (start, end].
         reached = range(
             (start // WORDS_LOG_PERIOD + 1) * WORDS_LOG_PERIOD, end + 1, WORDS_LOG_PERIOD
         )
-        words = found["words"].pop(start, log / f"words-{start:08d}.parquet")
+        words = found["words"].pop(start, chunk_path(trial_dir, "words", start))
         if reached and not words.exists():
             raise TrialError(_lost(f"{words} is missing (words at {reached[0]} to {reached[-1]})"))
         if words.exists():
@@ -171,7 +180,8 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     files leave temporary files out)."""
     trial_dir = Path(trial_dir)
     removed = []
-    for folder in (trial_dir, trial_dir / LOG_DIR):
+    log = trial_dir / LOG_DIR
+    for folder in (trial_dir, log, *(log / kind for kind in LOG_KINDS)):
         for path in sorted(folder.glob(".*.tmp")):
             pid = storage.temporary_writer(path.name)
             if pid is not None and not _alive(pid):
@@ -193,7 +203,7 @@ def prepare_resume(
     if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
         # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
         # trial.py): logs without one are a trial whose checkpoints were lost.
-        chunks = [p for p in (trial_dir / LOG_DIR).glob("*") if log_chunk_start(p) is not None]
+        chunks = [p for kind in LOG_KINDS for p in _chunks(trial_dir, kind).values()]
         if chunks:
             raise TrialError(
                 f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint "
@@ -226,13 +236,19 @@ def prepare_resume(
         notices.append(
             f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
         )
+    moved = move_old_chunks(trial_dir, config)
+    if moved:
+        notices.append(
+            f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
+            "log/words-*.parquet) into log/iterations/ and log/words/"
+        )
     return restored
 
 
 def drop_logs_past(trial_dir: Path, iteration: int) -> None:
     """Delete the log chunks that start at `iteration` or later: the work past a checkpoint,
     which the resumed run rewrites."""
-    for chunk in (trial_dir / LOG_DIR).glob("*.parquet"):
-        start = log_chunk_start(chunk)
-        if start is not None and start >= iteration:
-            chunk.unlink()
+    for kind in LOG_KINDS:
+        for start, chunk in _chunks(trial_dir, kind).items():
+            if start >= iteration:
+                chunk.unlink()

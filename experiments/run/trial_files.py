@@ -5,10 +5,15 @@ A trial directory holds:
 - `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
   every `checkpoint_every` iterations and at the end, with the one before it kept beside it
   as `checkpoint.prev.npz`: a damaged newest checkpoint costs at most two periods;
-- `log/iterations-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model, events),
-  one file per checkpoint period, starting at iteration NNNNNNNN;
-- `log/words-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to each
-  of the 6 words, in the chunk of the period that reaches them;
+- `log/iterations/chunk-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model,
+  events, goal, outcome, every model's interest), one file per checkpoint period, starting at
+  iteration NNNNNNNN;
+- `log/words/chunk-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to
+  each of the 6 words, in the chunk of the period that reaches them;
+  every row of both carries its source (trial, seed, backend, voice); the columns are listed in
+  experiments/analysis/logs.py, which reads them back (trials of the old layout too:
+  log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
+- `log/README.txt`: which folder of log/ to read (a reader of all of log/ stops on it);
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
   iterations, one entry per run or resume (experiments/provenance.py);
 - `.lock`: the lock of its one writer (experiments/run/lock.py).
@@ -29,9 +34,9 @@ import numpy as np
 from experiments import storage
 from experiments.config_file import identity_form
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
-from learner.agent import Agent
+from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
-from models.layout import TOYS, context_indices
+from models.layout import BLOCK_DIM, MODELS, TOYS, context_indices
 from sim import Playroom
 from sim import events as ev
 from sim.config import WorldConfig, config_from_dict
@@ -40,6 +45,29 @@ from sim.vocal.config import VoiceConfig
 # Iterations between two rows of the words log: the vocal learning curves are read every 100
 # iterations (docs/protocol.md §10).
 WORDS_LOG_PERIOD = 100
+
+# What log/README.txt says (experiments/file_names.py: why it is there).
+LOG_README = """\
+This folder holds a trial's logs, one folder per kind, one Parquet chunk per checkpoint period:
+  iterations/  one row per iteration          pd.read_parquet("TRIAL/log/iterations")
+  words/       every 100 iterations, the best distance reached so far to each word
+                                              pd.read_parquet("TRIAL/log/words")
+The kinds have different rows: read one of the folders, not this one (this file stops a reader
+of the whole folder before it mixes them). Every row names its trial, seed, backend and voice.
+With the project installed: `from experiments.logs import read_log, read_batch_logs`; the
+columns are described in experiments/analysis/logs.py.
+"""
+
+# The learner's columns of the iterations log: the goal and the outcome in the chosen model's
+# sensory block, and every model's interest (experiments/analysis/logs.py says what each holds).
+GOAL_COLUMNS = tuple(f"goal_{i}" for i in range(BLOCK_DIM))
+REACHED_COLUMNS = tuple(f"reached_{i}" for i in range(BLOCK_DIM))
+INTEREST_COLUMNS = tuple(f"interest_{k}" for k in range(len(MODELS)))
+LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
+# Stored as float32: 7 significant digits are plenty to plot and average them, at half the size
+# of float64 (random goals hardly compress). The other columns keep their types.
+LEARNER_DTYPE = np.float32
+_NO_BLOCK = np.full(BLOCK_DIM, np.nan)
 
 # Settings a resume may change: a trial can be extended to more iterations.
 EXTENSIBLE = ("trial.iterations",)
@@ -100,6 +128,22 @@ def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
         elif e.kind == ev.STICK_RETURNED:
             row["stick_returned"] = True
     return row
+
+
+def learner_values(
+    proposal: Proposal, reached: np.ndarray | None, interests: np.ndarray
+) -> np.ndarray:
+    """The learner's columns of an iteration's row (LEARNER_COLUMNS), (30,): the goal (NaN
+    without one: the bootstrap's random motor babbling), the outcome in the goal's block
+    (`Agent.outcome`, NaN without a model) and each model's interest when the model was
+    chosen (`Agent.interests`, read before the iteration's attempt)."""
+    return np.concatenate(
+        (
+            _NO_BLOCK if proposal.goal is None else proposal.goal,
+            _NO_BLOCK if reached is None else reached,
+            interests,
+        )
+    )
 
 
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:

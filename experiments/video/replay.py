@@ -136,8 +136,11 @@ def render_trial(
                     )
 
                 proposal, context, feedback = agent.play(room, act=filmed)
-                logged = {"iteration": it, **logged_rows.loc[it].to_dict()}
                 replayed = log_row(it, proposal, feedback, context)
+                # The events' columns: the log's other columns (its source, the learner's
+                # goal and interests) are not what filming could change.
+                row = {"iteration": it, **logged_rows.loc[it].to_dict()}
+                logged = {k: row.get(k) for k in replayed}
                 results.append(ReplayedIteration(it, logged, replayed))
             else:
                 agent.play(room)

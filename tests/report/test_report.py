@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from summary_checks import check_summary
 
 from experiments.analysis.curves import curve_rows, tool_numbers
 from experiments.analysis.results import ReportError, collect
@@ -89,6 +90,13 @@ def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     assert "as the study computed it (paper Fig. 4)" in text
     assert "<h2>Tool use and a minimum motion</h2>" in text
     assert not list(out.glob(".*.tmp"))
+    # Its numbers, machine-readable, beside it (tests/report/summary_checks.py).
+    summary = check_summary(out, text, REPORT_FILE)
+    assert summary["groups"] == ["kinematic"] and summary["by_group"]["kinematic"]["seeds"] == [
+        0,
+        1,
+    ]
+    assert summary["paper"]["competence_all"]["runs"] == 100
 
 
 def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
@@ -121,6 +129,11 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     # Where the trials ran (tests/run/test_provenance.py): all here, counted per side.
     section = text.split("<h2>Where the trials ran</h2>")[1].split("<h2>")[0]
     assert "<td>3 (kinematic 2, physical 1)</td><td>3 (kinematic 2, physical 1)</td>" in section
+    # Its numbers and tests, machine-readable, beside it (tests/report/summary_checks.py).
+    summary = check_summary(out, text, COMPARISON_FILE)
+    assert summary["groups"] == ["kinematic", "physical"]
+    assert [t["seed"] for t in summary["trials"]] == [0, 1, 0]
+    assert summary["tests"]["rows"][0][0] == "Normalised competence, all rings"
 
 
 # Statistics on hand-made tables ----------------------------------------------------------------

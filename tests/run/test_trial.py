@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from trial_logs import same_logs
 
 from experiments import storage
 from experiments.analysis.logs import read_log
@@ -99,8 +100,7 @@ def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path, grasp, seed):
     b, meta_b = storage.read_arrays(killed / CHECKPOINT_FILE)
     _arrays_equal(a, b)
     assert meta_a == meta_b
-    for kind in ("iterations", "words"):
-        assert read_log(whole, kind).equals(read_log(killed, kind))
+    same_logs(whole, killed)
 
 
 def test_a_3000_iteration_run_learns_to_reach_hand_goals(trained_trial):

@@ -9,9 +9,9 @@ import threading
 
 import numpy as np
 import pytest
+from trial_logs import same_logs
 
 from experiments import storage
-from experiments.analysis.logs import read_log
 from experiments.batches.runner import run_and_evaluate
 from experiments.file_names import (
     CHECKPOINT_FILE,
@@ -47,8 +47,7 @@ def _same_trial(a, b) -> None:
     for key in arrays_a:
         np.testing.assert_array_equal(arrays_a[key], arrays_b[key], err_msg=key)
     assert meta_a == meta_b
-    for kind in ("iterations", "words"):
-        assert read_log(a, kind).equals(read_log(b, kind)), kind
+    same_logs(a, b)
 
 
 @pytest.fixture

@@ -10,9 +10,9 @@ import subprocess
 import sys
 
 import pytest
+from trial_logs import same_logs
 
 from experiments import storage
-from experiments.analysis.logs import read_log
 from experiments.batches.runner import is_complete, run_and_evaluate
 from experiments.cli.main import main
 from experiments.file_names import (
@@ -63,8 +63,7 @@ def _same_trial(a, b) -> None:
     assert sorted(arrays_a) == sorted(arrays_b) and meta_a == meta_b
     for key in arrays_a:
         assert (arrays_a[key] == arrays_b[key]).all(), key
-    for kind in ("iterations", "words"):
-        assert read_log(a, kind).equals(read_log(b, kind)), kind
+    same_logs(a, b)
 
 
 def _cli(capsys, *argv: str) -> tuple[int, list[str]]:
@@ -176,9 +175,9 @@ def test_a_checkpoint_without_identity_is_taken_with_a_notice(base, tmp_path):
 
 # 3. Completeness checks read what they rely on -----------------------------------------------
 LOG_DAMAGE = {
-    "missing chunk": ("iterations-00000100.parquet", "is missing", lambda p: p.unlink()),
-    "truncated chunk": ("iterations-00000100.parquet", "damaged or truncated", _truncate),
-    "missing words": ("words-00000100.parquet", "is missing", lambda p: p.unlink()),
+    "missing chunk": ("iterations/chunk-00000100.parquet", "is missing", lambda p: p.unlink()),
+    "truncated chunk": ("iterations/chunk-00000100.parquet", "damaged or truncated", _truncate),
+    "missing words": ("words/chunk-00000100.parquet", "is missing", lambda p: p.unlink()),
 }
 
 
@@ -216,7 +215,8 @@ def test_temporary_files_of_killed_writers_are_removed_and_never_results(base, t
     dead = _dead_pid()
     litter = [
         out / f".{CHECKPOINT_FILE}.{dead}.tmp",
-        out / LOG_DIR / f".iterations-00000200.parquet.{dead}.tmp",
+        out / LOG_DIR / "iterations" / f".chunk-00000200.parquet.{dead}.tmp",
+        out / LOG_DIR / f".iterations-00000200.parquet.{dead}.tmp",  # of the old layout
     ]
     for path in litter:
         path.write_bytes(b"half a file")

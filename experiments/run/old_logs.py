@@ -1,0 +1,61 @@
+"""Trials of the old log layout brought into the folders, on resume.
+
+Trials written before each kind of log had its folder hold `log/iterations-NNNNNNNN.parquet`
+and `log/words-NNNNNNNN.parquet` side by side, without the columns rows carry since (their
+source: trial, seed, backend, voice; the learner's goal, outcome and interests). Every reader
+reads them as they are (experiments/analysis/log_chunks.py); a resume, which writes new chunks
+into the folders, first brings the old ones there too, so that a kind's folder reads as one
+table (`pd.read_parquet("TRIAL/log/iterations")`).
+
+Each chunk is brought over in two atomic steps: its missing columns are added in place (the
+source from config.json, NaN for the learner's columns, which were not logged then; rows and
+existing columns unchanged), then it is renamed into its folder. A resume killed at any moment
+leaves every chunk whole in one layout or the other, which both readers read, and the next
+resume finishes the move.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from experiments import storage
+from experiments.analysis.log_chunks import chunk_path, old_chunks
+from experiments.analysis.logs import SOURCE_COLUMNS, source_of
+from experiments.run.trial_files import LEARNER_COLUMNS, LEARNER_DTYPE
+
+
+def move_old_chunks(trial_dir: Path, config: dict) -> int:
+    """Bring the chunks of the old layout into their kinds' folders (module docstring);
+    returns how many were moved. Called under the directory's lock, after the logs were
+    checked (a chunk found in both layouts stops that check)."""
+    source = source_of(trial_dir, config)
+    moved = 0
+    for kind, start, path in old_chunks(trial_dir):
+        target = chunk_path(trial_dir, kind, start)
+        target.parent.mkdir(exist_ok=True)
+        try:
+            table = storage.read_table(path)
+        except storage.CorruptFileError:
+            # Past the checkpoint (the check read every chunk before it): the resume deletes
+            # it and writes it again.
+            os.replace(path, target)
+            moved += 1
+            continue
+        added = False
+        for position, column in enumerate(SOURCE_COLUMNS):
+            if column not in table.columns:
+                table.insert(position, column, source[column])
+                added = True
+        if kind == "iterations":
+            for column in LEARNER_COLUMNS:
+                if column not in table.columns:
+                    table[column] = np.full(len(table), np.nan, dtype=LEARNER_DTYPE)
+                    added = True
+        if added:
+            storage.write_table(path, table, plain=LEARNER_COLUMNS if kind == "iterations" else ())
+        os.replace(path, target)
+        moved += 1
+    return moved
