@@ -14,6 +14,12 @@ from experiments.cli.args import RUN_DEFAULTS, UsageError
 from experiments.cli.overrides import merged
 
 
+def percent(fraction: float) -> str:
+    """Competence as the report pages print it (experiments/report/pages.pct, one decimal):
+    "-0.8%", "46.0%", "n/a". Kept here so that the CLI's summaries load no report code."""
+    return "n/a" if not np.isfinite(fraction) else f"{100 * fraction:.1f}%"
+
+
 def cmd_random(args: argparse.Namespace) -> None:
     """Random arm commands in one backend, with a summary of what happened."""
     from models.layout import ARM_DIM
@@ -92,8 +98,8 @@ def cmd_eval(args: argparse.Namespace) -> None:
     )
     print(f"  {computed_on_line(args.dir)}")
     print(
-        "  normalised competence (0 = random agent, 1 = perfect): "
-        + ", ".join(f"{k} {val:+.2f}" for k, val in c.items())
+        "  normalised competence (0% = random agent, 100% = perfect): "
+        + ", ".join(f"{k} {percent(val)}" for k, val in c.items())
     )
     for ring, shares in summary["strategy_share"].items():
         print(f"  strategies {ring}: " + ", ".join(f"{k} {v:.0%}" for k, v in shares.items()))
@@ -125,7 +131,7 @@ def cmd_batch(args: argparse.Namespace) -> None:
         raise UsageError(str(exc)) from None
     for name, summary in sorted(results.items()):
         c = summary["competence"]
-        print(f"  {name}: competence ring1 {c['ring1']:+.2f}, all {c['all']:+.2f}")
+        print(f"  {name}: competence ring1 {percent(c['ring1'])}, all {percent(c['all'])}")
     print(f"{args.out}: {len(spec.trials())} trials complete")
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 
 import numpy as np
@@ -109,6 +110,9 @@ def test_eval_of_a_trial_writes_its_files_and_leaves_the_trial_unchanged(
     assert tuple(named["word"]) == names and (vocal["toy"] > 0).equals(vocal["is_name"])
     assert (trial / "checkpoint.npz").read_bytes() == checkpoint
     assert main(["eval", str(trial), "--placements", "2", "--quiet"]) == 0
-    assert "normalised competence" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    # Competence in %, as the report pages print it, not as a fraction.
+    assert "normalised competence (0% = random agent, 100% = perfect)" in out
+    assert re.search(r"all -?\d+\.\d%", out), out
     assert main(["eval", str(tmp_path / "nothing")]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1

@@ -88,3 +88,11 @@ def test_a_paper_number_without_its_run_count_is_refused(tmp_path):
     path.write_text(json.dumps(raw))
     with pytest.raises(ValueError, match="competence_all runs must be a whole number"):
         paper.load(path)
+
+
+@pytest.mark.parametrize("fraction", [0.46, -0.008, 0.0, 1.0, float("nan")])
+def test_the_cli_prints_competence_as_the_pages_do(fraction):
+    from experiments.cli.commands import percent
+    from experiments.report.pages import pct
+
+    assert percent(fraction) == pct(fraction, 1)
