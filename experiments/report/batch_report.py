@@ -18,7 +18,7 @@ from experiments.analysis.results import BatchResults, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import summarise_batch
 from experiments.file_names import REPORT_FILE
-from experiments.report import name_strategies, paper, tool_rule
+from experiments.report import intro, name_strategies, paper, tool_rule
 from experiments.report.figures import FigureFile, report_figures
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
@@ -57,6 +57,7 @@ def write_report(
         where_note=where_note,
         **name_strategies.page_context(results, geometry.threshold),
         **tool_rule.page_context(results),
+        **intro.page_context(results, geometry),
     )
     content = page_summary(
         results, numbers, published, page=REPORT_FILE, batches=[str(results.batch_dir)]

@@ -36,7 +36,7 @@ from experiments.analysis.stats import (
     welch,
 )
 from experiments.file_names import COMPARISON_FILE
-from experiments.report import name_strategies, paper, tool_rule
+from experiments.report import intro, name_strategies, paper, tool_rule
 from experiments.report.batch_report import numbers_and_figures
 from experiments.report.figures import FigureFile
 from experiments.report.pages import (
@@ -300,6 +300,7 @@ def write_comparison(
         where_note=where_note,
         **name_strategies.page_context(merged, geometry.threshold),
         **tool_rule.page_context(merged),
+        **intro.page_context(merged, geometry),
     )
     content = page_summary(
         merged,

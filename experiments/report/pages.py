@@ -56,14 +56,32 @@ def p_value(p: float) -> str:
     return f"p = {p:.3f}" if p >= 1e-3 else f"p = {p:.1e}"
 
 
+# Below this many trials a group's t interval rests on too few values to trust: the pages say
+# so beside the interval and above the first table.
+FEW_TRIALS = 5
+
+
+def interval_notes(low: float, high: float, n: int) -> list[str]:
+    """Warnings for an interval that would mislead as printed: zero width (all trials equal,
+    or narrower than the 0.1% printed) and fewer than FEW_TRIALS trials behind it."""
+    notes = []
+    if pct(low, 1) == pct(high, 1):
+        notes.append("all trials equal" if low == high else "interval under 0.1% wide")
+    if n < FEW_TRIALS:
+        notes.append(f"fewer than {FEW_TRIALS} trials")
+    return notes
+
+
 def ci_text(row: pd.Series) -> str:
-    """A row of `stats.competence_summary` as "mean [95% CI low, high] (n=...)"."""
+    """A row of `stats.competence_summary` as "mean [95% CI low, high] (n=...)", with
+    `interval_notes` after n where the interval would mislead."""
     if not np.isfinite(row["mean"]):
         return "n/a"
     if not np.isfinite(row["low"]):
         return f"{pct(row['mean'], 1)} (n={row['n']}, no interval)"
     interval = f"[95% CI {pct(row['low'], 1)}, {pct(row['high'], 1)}]"
-    return f"{pct(row['mean'], 1)} {interval} (n={row['n']})"
+    notes = "".join(f"; {note}" for note in interval_notes(row["low"], row["high"], row["n"]))
+    return f"{pct(row['mean'], 1)} {interval} (n={row['n']}{notes})"
 
 
 def shares_text(row: pd.Series) -> str:

@@ -118,21 +118,21 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
             paper["competence_all"].cell,
             *competence_of("all"),
         ],
-        [f"… ring 1 (toy within hand reach, d < {h:g})", NOT_PUBLISHED, *competence_of("ring1")],
-        [f"… ring 2 ({h:g} ≤ d < {s:g})", NOT_PUBLISHED, *competence_of("ring2")],
-        [f"… ring 3 ({s:g} ≤ d ≤ 1)", NOT_PUBLISHED, *competence_of("ring3")],
+        [f"… ring 1 (toy within hand reach, d < {h:g} m)", NOT_PUBLISHED, *competence_of("ring1")],
+        [f"… ring 2 ({h:g} ≤ d < {s:g} m)", NOT_PUBLISHED, *competence_of("ring2")],
+        [f"… ring 3 ({s:g} ≤ d ≤ 1 m)", NOT_PUBLISHED, *competence_of("ring3")],
         [
-            f"Strategy hand / tool / vocal, centre region (d < {h:g})",
+            f"Strategy hand / tool / vocal, centre region (d < {h:g} m)",
             paper["strategy_centre"].cell,
             *shares_of("centre"),
         ],
         [
-            f"Strategy hand / tool / vocal, between hand and stick limits ({h:g} ≤ d < {s:g})",
+            f"Strategy hand / tool / vocal, between hand and stick limits ({h:g} ≤ d < {s:g} m)",
             paper["strategy_between_limits"].cell,
             *shares_of("between limits"),
         ],
         [
-            f"Strategy hand / tool / vocal, at distance 1 (d ≥ {DISTANCE_ONE:g})",
+            f"Strategy hand / tool / vocal, at distance 1 (d ≥ {DISTANCE_ONE:g} m)",
             paper["strategy_distance_1"].cell,
             *shares_of("distance 1"),
         ],
@@ -219,12 +219,12 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
             for r in (1, 2, 3)
         ],
         [
-            f"Strategy hand / tool / vocal, centre (Fig. 4's curve, x < 0.6), {label}",
+            f"Strategy hand / tool / vocal, centre (Fig. 4's curve, x < 0.6 m), {label}",
             paper["strategy_centre"].cell,
             *[of(x, shares("centre")) for x in groups],
         ],
         [
-            f"Strategy hand / tool / vocal, between the limits (0.6 ≤ x < 0.85), {label}",
+            f"Strategy hand / tool / vocal, between the limits (0.6 ≤ x < 0.85 m), {label}",
             paper["strategy_between_limits"].cell,
             *[of(x, shares("between_limits")) for x in groups],
         ],

@@ -41,7 +41,13 @@ def _num(x, digits: int = 2) -> str:
 def _competence(c: dict) -> str:
     if c["low"] is None:
         return f"{_pct(c['mean'], 1)} (n={c['n']}, no interval)"
-    return f"{_pct(c['mean'], 1)} [95% CI {_pct(c['low'], 1)}, {_pct(c['high'], 1)}] (n={c['n']})"
+    notes = ""
+    if _pct(c["low"], 1) == _pct(c["high"], 1):  # a zero-width interval is flagged
+        notes += "; all trials equal" if c["low"] == c["high"] else "; interval under 0.1% wide"
+    if c["n"] < 5:  # and so is a tiny sample
+        notes += "; fewer than 5 trials"
+    interval = f"[95% CI {_pct(c['low'], 1)}, {_pct(c['high'], 1)}]"
+    return f"{_pct(c['mean'], 1)} {interval} (n={c['n']}{notes})"
 
 
 def _shares(s: dict) -> str:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from page_checks import check_explained
 from summary_checks import check_summary
 
 from experiments.analysis.curves import curve_rows, tool_numbers
@@ -86,6 +87,7 @@ def test_report_writes_figures_and_embeds_them_all(batches, tmp_path):
     for published in ("46%", "0.23", "0.30", "88%", "1e-72", "38% / 13% / 49%"):
         assert published in text
     assert "2 trials" in text and "this batch: kinematic" in text
+    check_explained(text, n_trials_warned=True)
     assert (out / "fig4-strategies-as-the-study-computed-it.png").exists()  # study tests held
     assert "as the study computed it (paper Fig. 4)" in text
     assert "<h2>Tool use and a minimum motion</h2>" in text
@@ -111,6 +113,7 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     _embedded(page, out, "comparison-*.png")
     text = page.read_text()
     assert "kinematic" in text and "physical" in text
+    check_explained(text, n_trials_warned=True)
     assert "Welch t" in text and "Mann-Whitney U" in text and "χ²" in text
     assert "not recorded" in text and "5.00 ms / iteration" in text
     # The stick as a tool, per backend: in reach, grasps, catches, returns, held or pushed.
