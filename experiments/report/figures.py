@@ -96,8 +96,8 @@ def competence_map_figure(
         ax.set_aspect("equal")
         ax.set_xticks([-1, -0.5, 0, 0.5, 1])
         ax.set_yticks([-1, -0.5, 0, 0.5, 1])
-        ax.set_xlabel("toy x")
-        ax.set_ylabel("toy y")
+        ax.set_xlabel("toy x (m from the arm's base)")
+        ax.set_ylabel("toy y (m from the arm's base)")
     assert mesh is not None, "no group to draw"
     bar = fig.colorbar(mesh, ax=axes, shrink=0.85, extend="min")
     bar.set_label("normalised competence (%)\n0 = random agent, 100 = perfect")
@@ -137,7 +137,7 @@ def strategy_by_distance(
             ax.text(x + 0.01, 97, label, fontsize=8, va="top")
         ax.set_xlim(0, 1)
         ax.set_ylim(0, 100)
-        ax.set_xlabel("toy distance to the arm's base")
+        ax.set_xlabel("toy distance to the arm's base (m)")
         ax.set_ylabel("share of tests (%)")
         ax.set_title(f"{group} ({len(rows)} tests, at least {int(counts.min())} per bin)")
         ax.grid(alpha=0.3)
@@ -177,7 +177,9 @@ def vocal_errors(vocal: pd.DataFrame, groups: list[str], threshold: float) -> Fi
         )
         below = (rows["best_distance"] < threshold).mean()
         ax.set_title(f"{group}: {100 * below:.0f}% of words below {threshold}")
-        ax.set_xlabel("best distance between the word and the agent's sounds")
+        ax.set_xlabel(
+            "best distance between the word and the agent's sounds\n(formant features, log2 Hz)"
+        )
         ax.set_ylabel("number of words")
         ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlim(0, top)
@@ -199,12 +201,14 @@ def development(bands: pd.DataFrame, groups: list[str], bootstrap: int, threshol
         (
             axes[2],
             [("best_distance_names", "-"), ("best_distance_distractors", "--")],
-            "best distance to the caregiver's words",
+            "best distance to the caregiver's words (log2 Hz)",
             1,
             np.inf,
         ),
     )
     _band_panels(panels, bands, groups, bootstrap)
+    for ax in axes[:2]:
+        ax.set_ylim(bottom=0)  # shares: an axis fitted to the data would exaggerate changes
     axes[2].axhline(threshold, color="k", lw=1, ls=":", label=f"threshold {threshold}")
     axes[0].set_title("Tool use")
     axes[1].set_title("Words the caregiver recognised")
@@ -252,7 +256,7 @@ def _band_panels(panels: tuple, bands: pd.DataFrame, groups: list[str], bootstra
                     alpha=0.2,
                     lw=0,
                 )
-        ax.set_xlabel("iteration")
+        ax.set_xlabel("iteration (movements since the start)")
         ax.set_ylabel(ylabel)
         ax.set_xlim(left=0)
         ax.grid(alpha=0.3)
@@ -267,6 +271,11 @@ def stick_in_play(bands: pd.DataFrame, groups: list[str], bootstrap: int) -> Fig
         (axes[2], [("tool_use", "-")], "toys caught per 1000 arm movements", 1000, 1),
     )
     _band_panels(panels, bands, groups, bootstrap)
+    # The whole 0-100% range: the share stays near 100%, and an axis fitted to the data
+    # (97.5-100%) made dips of a point look like collapses.
+    axes[0].set_ylim(0, 100)
+    for ax in axes[1:]:
+        ax.set_ylim(bottom=0)  # rates: zero is the honest floor
     for ax, title in zip(axes, ("Stick within reach", "Stick grasped", "Toy caught"), strict=True):
         ax.set_title(title)
         if ax.get_legend_handles_labels()[0]:

@@ -55,7 +55,7 @@ def study_strategy_figure(results: BatchResults, published: dict[str, PaperNumbe
         for limit in (HAND_LIMIT, STICK_LIMIT):
             axis.axvline(limit, color="black", linestyle="--", linewidth=1)
         axis.set_title(group)
-        axis.set_xlabel("distance to centre (Fig. 4's axis: bin / 49)")
+        axis.set_xlabel("toy distance to the arm's base (m; Fig. 4's axis: pixel bin / 49)")
         axis.set_xlim(0.0, 1.03)
         axis.set_ylim(0.0, 100.0)
     axes[0].set_ylabel("strategy use (%)")

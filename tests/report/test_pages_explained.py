@@ -38,3 +38,28 @@ def test_rings_are_said_in_metres_with_who_reaches_them():
     # Rings of another layout are given in metres without a meaning they do not have.
     other = {"world": {"toy_rings": [[0.0, 0.3], [0.3, 1.0]]}}
     assert rings_text(other, geometry) == ["ring 1: 0–0.3 m", "ring 2: 0.3–1 m"]
+
+
+def _bands(metrics: list[str]) -> pd.DataFrame:
+    """Curves that barely move near the top of their range: 97.5-100% within reach."""
+    rows = []
+    for metric in metrics:
+        for i, value in enumerate((1.0, 0.975, 0.99)):
+            rows.append(("kinematic", metric, 100 * (i + 1), value, value - 0.01, value))
+    return pd.DataFrame(rows, columns=["group", "metric", "iteration", "mean", "low", "high"])
+
+
+def test_figure_axes_start_at_zero_and_carry_units():
+    from experiments.report.figures import development, stick_in_play
+
+    stick = stick_in_play(_bands(["stick_in_reach", "stick_grasp", "tool_use"]), ["kinematic"], 50)
+    reach, grasps, catches = stick.axes
+    assert reach.get_ylim() == (0.0, 100.0) and "%" in reach.get_ylabel()
+    assert grasps.get_ylim()[0] == 0 and catches.get_ylim()[0] == 0
+    metrics = ["tool_use", "word_recognised", "best_distance_names", "best_distance_distractors"]
+    curves = development(_bands(metrics), ["kinematic"], 50, 0.4)
+    tool, words, distance = curves.axes
+    assert tool.get_ylim()[0] == 0 and words.get_ylim()[0] == 0
+    assert "(log2 Hz)" in distance.get_ylabel()
+    for ax in (*stick.axes, *curves.axes):
+        assert "iteration" in ax.get_xlabel()
