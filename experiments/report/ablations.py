@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import textwrap
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -35,7 +36,9 @@ from experiments.analysis.results import BatchResults, ReportError, check_out_di
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import STRATEGIES, paired_difference, vocal_summary
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
+from experiments.report import paper
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
+from experiments.report.pages import pct
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
 BOOKKEEPING = ("trial.preset", "trial.overrides")
@@ -223,12 +226,56 @@ def csv_table(rows: list[AblationRow]) -> pd.DataFrame:
     return pd.DataFrame(records)
 
 
+# The study's regions in words, for the figure's legends.
+REGION_WORDS = {"centre": "centre", "between_limits": "between limits", "distance_1": "distance 1"}
+# The paper's vocal shares per study region (experiments/report/data/paper.json's keys).
+PAPER_VOCAL = {
+    "centre": "strategy_centre",
+    "between_limits": "strategy_between_limits",
+    "distance_1": "strategy_distance_1",
+}
+# A setting's dotted key ("learner.exploration_sigma"): its part ("learner") and its name.
+_KEY = re.compile(r"\b([a-z]\w*)\.([a-z][\w.]*)")
+
+
+def figure_label(label: str) -> str:
+    """A row's label in words for the figure: "learner.exploration_sigma: 0.05 -> 0.1" reads
+    "exploration sigma (learner): 0.05 → 0.1"; the table and the CSV keep the dotted keys
+    (they name the settings exactly, for `--set`)."""
+    words = _KEY.sub(lambda m: f"{m.group(2).split('.')[-1]} ({m.group(1)})", label)
+    return words.replace("_", " ").replace(" -> ", " → ")
+
+
+def _draw_paper(middle, right) -> None:
+    """The paper's numbers as references: the vocal share of each region (a band where it
+    gives a range) and the medians of names and distractors."""
+    published = paper.published()
+    for (region, key), style in zip(PAPER_VOCAL.items(), ("/", "\\", "-"), strict=True):
+        value = published[key].value["vocal"]
+        low, high = (value, value) if isinstance(value, float) else value
+        label = f"paper, {REGION_WORDS[region]}: {pct(low)}" + (
+            f"–{pct(high)}" if high != low else ""
+        )
+        if high == low:
+            middle.axvline(100 * low, color="0.4", ls="--", lw=1, label=label)
+        else:
+            middle.axvspan(100 * low, 100 * high, color="0.85", hatch=style, alpha=0.6, label=label)
+    for key, colour, words in (
+        ("median_names", "tab:purple", "names"),
+        ("median_distractors", "tab:grey", "distractors"),
+    ):
+        value = published[key].value
+        right.axvline(value, color=colour, ls=":", lw=1.5, label=f"paper, {words}: {value:g}")
+
+
 def ablation_figure(rows: list[AblationRow]) -> Figure:
     """Left: the paired difference of the project's competence from the baseline, with its 95%
-    interval. Middle: the vocal share of each study region. Right: the names effect."""
-    fig = Figure(figsize=(14, 0.7 * len(rows) + 2.0), layout="constrained")
+    interval. Middle: the vocal share of each study region. Right: the names effect. The
+    paper's numbers are drawn where it gives some; labels are in words."""
+    fig = Figure(figsize=(15, 0.7 * len(rows) + 3.2), layout="constrained")
     left, middle, right = fig.subplots(1, 3, sharey=True)
     y = list(range(len(rows)))[::-1]
+    _draw_paper(middle, right)
     for yi, row in zip(y, rows, strict=True):
         if math.isfinite(row.difference):
             left.errorbar(
@@ -244,26 +291,37 @@ def ablation_figure(rows: list[AblationRow]) -> Figure:
             )
         for marker, region in zip("o^s", STUDY_REGIONS, strict=True):
             share = row.study_strategies.get(region, {}).get("vocal", math.nan)
-            middle.plot(100 * share, yi, marker, color=STRATEGY_COLOURS["vocal"], label=region)
+            middle.plot(
+                100 * share, yi, marker, color=STRATEGY_COLOURS["vocal"], label=REGION_WORDS[region]
+            )
         right.plot(row.median_names, yi, "o", color="tab:purple", label="toy names")
         right.plot(row.median_distractors, yi, "x", color="tab:grey", label="distractors")
     left.axvline(0.0, color="grey", linewidth=0.8)
-    left.set_yticks(y, [textwrap.fill(row.label, 50) for row in rows], fontsize=8)
-    left.set_xlabel("competence, project's measure:\ndifference from the baseline (points)")
-    middle.set_xlabel("vocal strategy share,\nstudy's measure (%)")
-    right.set_xlabel("median best distance of words\n(lower is better)")
+    labels = [textwrap.fill(figure_label(row.label), 50) for row in rows]
+    left.set_yticks(y, labels, fontsize=8)
+    left.set_xlabel(
+        "competence, project's measure: difference\nfrom the baseline (percentage points, 95% CI)"
+    )
+    middle.set_xlabel("vocal strategy share, study's measure (%)")
+    middle.set_xlim(left=0)
+    right.set_xlabel("median best distance of words (log2 Hz)\n(lower is better)")
     for axis in (middle, right):
-        handles, labels = axis.get_legend_handles_labels()
-        unique = dict(zip(labels, handles, strict=True))
+        handles, names = axis.get_legend_handles_labels()
+        unique = dict(zip(names, handles, strict=True))
         axis.legend(
             unique.values(),
             unique.keys(),
-            fontsize=8,
+            fontsize=7,
             loc="lower left",
             bbox_to_anchor=(0.0, 1.0),
-            ncols=len(unique),
+            ncols=2,
             frameon=False,
         )
+    n = rows[0].n_trials if rows else 0
+    fig.suptitle(
+        "Ablations: each configuration against the baseline, paired by seed "
+        f"(baseline: {n} trials); grey and dotted: the paper's values"
+    )
     return fig
 
 

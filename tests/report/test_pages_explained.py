@@ -7,6 +7,8 @@ from __future__ import annotations
 import pandas as pd
 
 from experiments.analysis.geometry import Geometry
+from experiments.report import paper
+from experiments.report.ablations import STUDY_REGIONS, AblationRow, ablation_figure
 from experiments.report.intro import rings_text
 from experiments.report.pages import ci_text
 
@@ -63,3 +65,30 @@ def test_figure_axes_start_at_zero_and_carry_units():
     assert "(log2 Hz)" in distance.get_ylabel()
     for ax in (*stick.axes, *curves.axes):
         assert "iteration" in ax.get_xlabel()
+
+
+def _ablation_row(label: str, difference: float) -> AblationRow:
+    shares = {r: {"hand": 0.5, "tool": 0.2, "vocal": 0.3} for r in STUDY_REGIONS}
+    return AblationRow(
+        label, "batch", "kinematic", 4, 0.4, shares, 0.3, difference, difference - 0.05,
+        difference + 0.05, 0.2, 4, 0.8, 0.25, 0.31, 0.01,
+    )  # fmt: skip
+
+
+def test_the_ablation_figure_is_titled_in_words_with_the_papers_values():
+    rows = [
+        _ablation_row("baseline (study)", float("nan")),
+        _ablation_row("learner.exploration_sigma: 0.05 -> 0.1; world.stick_return: none", 0.02),
+    ]
+    fig = ablation_figure(rows)
+    assert "Ablations" in fig.get_suptitle()
+    left, middle, right = fig.axes[:3]
+    ticks = [t.get_text().replace("\n", " ") for t in left.get_yticklabels()]
+    assert ticks[1] == "exploration sigma (learner): 0.05 → 0.1; stick return (world): none"
+    assert "_" not in " ".join(ticks)
+    legends = [t.get_text() for ax in (middle, right) for t in ax.get_legend().get_texts()]
+    published = paper.published()
+    assert f"paper, names: {published['median_names'].value:g}" in legends
+    assert f"paper, distractors: {published['median_distractors'].value:g}" in legends
+    assert "paper, centre: 15%–20%" in legends and "between limits" in legends
+    assert not any("_" in text for text in legends)
