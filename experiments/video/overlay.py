@@ -1,4 +1,5 @@
-"""What a video draws over the rendered frames: caption, goal trajectory, events as they happen.
+"""What a video draws over the rendered frames: caption, goal trajectory, events as they happen,
+and the legend naming each object by its colour (experiments/video/legend.py).
 
 World points reach the image through `CameraView`, the pinhole projection of one MuJoCo camera
 at one instant (its pose from `data.cam_xpos` / `data.cam_xmat`, its vertical field of view
@@ -15,6 +16,12 @@ import mujoco
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from experiments.video.legend import (
+    LEGEND_MIN_HEIGHT,
+    draw_legend,
+    geom_colour,
+    legend_entries,
+)
 from models.layout import TRACKED_OBJECTS as TRACKED
 from sim import events as ev
 
@@ -156,14 +163,7 @@ def event_label(event: ev.Event) -> str:
 
 def object_colours(model: mujoco.MjModel) -> dict[str, tuple[int, int, int]]:
     """RGB (0-255) of each tracked object, taken from its geom's material in the model."""
-    colours = {}
-    for name, geom_name in OBJECT_GEOMS.items():
-        geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, geom_name)
-        mat = model.geom_matid[geom]
-        rgba = model.mat_rgba[mat] if mat >= 0 else model.geom_rgba[geom]
-        r, g, b = (int(round(255 * c)) for c in rgba[:3])
-        colours[name] = (r, g, b)
-    return colours
+    return {name: geom_colour(model, geom) for name, geom in OBJECT_GEOMS.items()}
 
 
 def object_plane_height(model: mujoco.MjModel) -> float:
@@ -198,6 +198,7 @@ class Overlay:
     ) -> None:
         self.width, self.height = width, height
         self.colours = object_colours(model)
+        self.legend = legend_entries(model)
         self.plane_z = object_plane_height(model)
         self.event_frames = max(1, int(round(event_seconds * fps)))
         size = max(MIN_FONT_PX, int(round(height * FONT_FRACTION)))
@@ -244,6 +245,8 @@ class Overlay:
             *([caption.sound] if caption.sound else []),
         ]
         self._text_box(pen, lines, [DEFAULT_EVENT_COLOUR] * len(lines), top=True)
+        if self.height >= LEGEND_MIN_HEIGHT:
+            draw_legend(pen, self.legend, self.font, self.line_px, self.margin, self.width)
         if shown:
             labels = [f"{e.step:2d}  {event_label(e)}" for e in shown]
             colours = [EVENT_COLOURS.get(e.kind, DEFAULT_EVENT_COLOUR) for e in shown]
