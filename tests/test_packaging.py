@@ -12,6 +12,8 @@ import sysconfig
 import zipfile
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).parent.parent
 # What a wheel is built from: the project's files, without the repository's other contents.
 SOURCES = ("pyproject.toml", "README.md", "models", "sim", "learner", "experiments")
@@ -54,6 +56,7 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
         assert 'extra == "dev"' in line, line
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_an_installed_wheel_runs_a_trial_outside_the_repository(tmp_path):
     wheel = _build_wheel(tmp_path)
     env_dir = tmp_path / "fresh-env"

@@ -54,6 +54,7 @@ def _wait_for_first_checkpoint(trial_dir: Path, polls: int = 2400) -> None:
         time.sleep(0.05)
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_smoke_profile_runs_on_a_local_cluster_with_two_workers(tmp_path, client):
     spec = load_spec("smoke")
     assert len(client.scheduler_info()["workers"]) == 2
@@ -66,6 +67,7 @@ def test_smoke_profile_runs_on_a_local_cluster_with_two_workers(tmp_path, client
     assert run_batch(spec, tmp_path, client=client, progress=False) == {}
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_rerun_resumes_an_unfinished_trial_from_its_checkpoint(tmp_path, client):
     spec = BatchSpec(
         grasps=("kinematic",),

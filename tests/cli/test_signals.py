@@ -69,6 +69,7 @@ def _lock_is_free(trial: Path) -> bool:
     return True
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_sigint_then_sigterm_end_a_run_with_one_line_and_it_resumes(tmp_path):
     out = tmp_path / "trial"
     args = ["run", "--out", str(out), "--iterations", "100000", "--checkpoint-every", "50"]
@@ -92,6 +93,7 @@ def test_sigint_then_sigterm_end_a_run_with_one_line_and_it_resumes(tmp_path):
     assert list(read_log(out)["iteration"]) == list(range(second))  # nothing lost or doubled
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_sigterm_ends_a_batch_with_one_line_saying_how_to_resume(tmp_path):
     config = tmp_path / "batch.json"
     config.write_text(

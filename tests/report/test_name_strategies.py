@@ -96,6 +96,7 @@ def test_trials_evaluated_before_the_toy_was_recorded_give_a_note(batches, tmp_p
     assert named_tests(old, 0.4) is None and name_strategy_table(old, 0.4) is None
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
     page = write_report(
         batches["kinematic"], tmp_path / "new", measures=room_measures(50)
@@ -111,6 +112,7 @@ def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
     assert "playroom eval" in page and NOT_RECORDED.split(":")[0] in page
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_the_comparison_splits_both_backends_by_name(batches, tmp_path):
     from experiments.report.comparison import write_comparison
 

@@ -386,6 +386,7 @@ def test_stick_numbers_of_a_hand_made_log():
     assert list(in_reach) == [0.5]
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_the_study_reference_is_played_once_and_kept(batches, tmp_path, monkeypatch):
     from experiments.measure import study_measure
 

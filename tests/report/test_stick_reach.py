@@ -78,7 +78,9 @@ def test_the_command_draws_the_figure_and_prints_the_table(tmp_path, capsys):
     for grasp in ("kinematic", "physical"):
         trial = batch / f"{grasp}-random-seed0000"
         (trial / LOG_DIR).mkdir(parents=True)
-        storage.write_json(trial / CONFIG_FILE, {"trial": {"grasp": grasp, "seed": 0}, "world": world})
+        storage.write_json(
+            trial / CONFIG_FILE, {"trial": {"grasp": grasp, "seed": 0}, "world": world}
+        )
         log = _log(
             [("arm", d, bool(rng.random() < 0.2)) for d in rng.uniform(0.25, 0.26, 200)]
             + _many("arm", 0.535, 200, 2 if grasp == "physical" else 40)

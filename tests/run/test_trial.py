@@ -72,10 +72,8 @@ def _checkpointed_iteration(trial_dir: Path) -> int:
         return 0
 
 
-@pytest.mark.parametrize(
-    "grasp, seed",
-    [("kinematic", 4), pytest.param("physical", 5, marks=pytest.mark.slow)],
-)
+@pytest.mark.slow  # over 5 s: make test-slow runs it
+@pytest.mark.parametrize("grasp, seed", [("kinematic", 4), ("physical", 5)])
 def test_killed_run_resumes_to_the_same_memory_and_logs(tmp_path, grasp, seed):
     total, period = 1500, 100
     args = ["run", "--grasp", grasp, "--iterations", str(total), "--seed", "4"]
@@ -124,6 +122,7 @@ def test_a_3000_iteration_run_learns_to_reach_hand_goals(trained_trial):
 
 
 # Bad input ----------------------------------------------------------------------------------
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_directory_with_a_trial_is_refused_without_resume(tmp_path):
     out = tmp_path / "t"
     args = ["run", "--iterations", "20", "--seed", "0", "--out", str(out), "--quiet"]

@@ -169,6 +169,7 @@ def _trial_with_last_checkpoint_lost(tmp_path, damage) -> tuple:
     return out, args
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_a_truncated_newest_checkpoint_falls_back_to_the_previous_one(tmp_path, whole_run):
     def truncate(path):
         path.write_bytes(path.read_bytes()[:300])

@@ -83,6 +83,7 @@ def test_kinematic_whole_movements_equal_the_stepped_rules_on_random_commands(co
         assert ev.WORD_RECOGNISED in kinds
 
 
+@pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_kinematic_whole_movements_equal_the_stepped_rules_on_scripted_tool_use():
     """Scripted scenes: take the handle, then sweep the tip through a toy, from many places."""
     fast, stepped = _twin_rooms("kinematic", seed=2)
