@@ -24,11 +24,8 @@ def with_added_settings(config: dict) -> dict:
     """A copy of a config with every added setting it lacks set to its earlier value."""
     out = copy.deepcopy(config)
     for key, value in ADDED_SETTINGS.items():
-        *parents, last = key.split(".")
-        node: object = out
-        for parent in parents:
-            node = node.get(parent) if isinstance(node, dict) else None
-        if isinstance(node, dict) and last not in node:
+        node, last = _section(out, key)
+        if node is not None and last not in node:
             node[last] = value
     return out
 
@@ -37,10 +34,17 @@ def identity_form(config: dict) -> dict:
     """A copy of a config without the added settings that hold their earlier value."""
     out = copy.deepcopy(config)
     for key, value in ADDED_SETTINGS.items():
-        *parents, last = key.split(".")
-        node: object = out
-        for parent in parents:
-            node = node.get(parent) if isinstance(node, dict) else None
-        if isinstance(node, dict) and node.get(last, value) == value:
+        node, last = _section(out, key)
+        if node is not None and node.get(last, value) == value:
             node.pop(last, None)
     return out
+
+
+def _section(config: dict, key: str) -> tuple[dict | None, str]:
+    """The dict that holds a dotted key's last part (None if the config lacks it), and that
+    part."""
+    *parents, last = key.split(".")
+    node: object = config
+    for parent in parents:
+        node = node.get(parent) if isinstance(node, dict) else None
+    return (node if isinstance(node, dict) else None), last
