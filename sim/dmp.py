@@ -115,7 +115,10 @@ def rollout(
     after each of the n_steps equal time steps of a movement lasting 1 (unitless time).
     """
     weights = np.atleast_2d(np.asarray(weights, dtype=float))
-    inputs = np.column_stack([np.asarray(start, float), np.asarray(end, float), weights])
+    inputs = np.empty((weights.shape[0], 2 + weights.shape[1]))  # C order, as column_stack's
+    inputs[:, 0] = start
+    inputs[:, 1] = end
+    inputs[:, 2:] = weights
     return inputs @ response_matrix(weights.shape[1], n_steps, kind)
 
 

@@ -52,18 +52,22 @@ def movement_events(
     grasped = {e.obj for e in step_events if e.kind in (TOY_GRASPED, STICK_GRASPED)}
     caught = {e.obj for e in step_events if e.kind == TOY_CAUGHT}
     moved: list[Event] = []
-    displacement = np.linalg.norm(positions - positions[0], axis=2)  # (51, 5)
-    for row, name in enumerate(TRACKED_OBJECTS[1:], start=1):
-        steps = np.flatnonzero(displacement[:, row] > MOVED_DISTANCE)
-        if steps.size == 0:
-            continue
+    objects = positions[:, 1:]  # the hand is not an object that moves
+    offsets = objects - objects[0]
+    # np.linalg.norm(offsets, axis=2)'s arithmetic (x*x + y*y, then the root) without its
+    # overhead, which was a third of this function's time.
+    dx, dy = offsets[..., 0], offsets[..., 1]
+    beyond = np.sqrt(dx * dx + dy * dy) > MOVED_DISTANCE  # (51, 4)
+    for row in np.flatnonzero(beyond.any(axis=0)):
+        name = TRACKED_OBJECTS[1 + row]
+        step = int(np.argmax(beyond[:, row]))
         if name == "stick":
             by = "hand" if "stick" in grasped else "push"
-            moved.append(Event(STICK_MOVED, int(steps[0]), obj="stick", by=by))
+            moved.append(Event(STICK_MOVED, step, obj="stick", by=by))
             continue
         if name == brought:
             by = "caregiver"
         else:
             by = "hand" if name in grasped else "stick" if name in caught else "push"
-        moved.append(Event(TOY_MOVED, int(steps[0]), obj=name, by=by))
+        moved.append(Event(TOY_MOVED, step, obj=name, by=by))
     return moved

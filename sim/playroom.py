@@ -40,6 +40,19 @@ from sim.vocal.registry import make_tract
 RANGE_TOLERANCE = 1e-9
 
 
+def _sample_indices() -> tuple[np.ndarray, np.ndarray]:
+    """Flat indices into (N_STEPS, 5, 2) positions and (N_STEPS, 2) sound of s's values: per
+    object its 5 x then its 5 y samples, then the sound's 5 F1 then 5 F2 samples."""
+    idx = list(SAMPLE_INDICES)
+    steps = np.arange(N_STEPS * len(TRACKED_OBJECTS) * 2).reshape(N_STEPS, -1, 2)
+    objects = steps[idx].transpose(1, 2, 0).ravel()
+    sound = np.arange(N_STEPS * 2).reshape(N_STEPS, 2)[idx].T.ravel()
+    return objects, sound
+
+
+_OBJECT_SAMPLES, _SOUND_SAMPLES = _sample_indices()
+
+
 class Playroom:
     """The playroom world the learner talks to, built on the dm_control task.
 
@@ -132,7 +145,9 @@ class Playroom:
         actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
-        formants = self.vocal_tract.trajectory_formants(articulators)
+        # The trajectory is finite and clipped to [-1, 1]: the tract's input checks
+        # (trajectory_formants) would only repeat that.
+        formants = self.vocal_tract.frame_formants(articulators.T)
         closed = self._closed_form()
         if closed is not None:
             feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
@@ -261,6 +276,8 @@ class Playroom:
         self, movement: str, actions: np.ndarray, voice_formants: np.ndarray | None = None
     ) -> Feedback:
         p = self.physics
+        if isinstance(self.backend, ClosedForm):  # placed by kinematics alone (see above)
+            mujoco.mj_forward(p.model.ptr, p.data.ptr)
         saved = self.get_state()
         n = N_STEPS
         positions = np.empty((n + 1, len(TRACKED_OBJECTS), 2))
@@ -329,11 +346,9 @@ class Playroom:
 
     def _sensory(self, positions: np.ndarray, sound: np.ndarray) -> np.ndarray:
         """(60,) from (50, 5, 2) positions and (50, 2) sound, sampled at the 5 steps."""
-        idx = list(SAMPLE_INDICES)
-        objects = positions[idx].transpose(1, 2, 0).reshape(len(TRACKED_OBJECTS), -1)  # x then y
         s = np.empty(SENSORY_DIM)
-        s[: objects.size] = objects.ravel()
-        s[block_slice("sound")] = sound[idx].T.ravel()
+        s[: _OBJECT_SAMPLES.size] = positions.take(_OBJECT_SAMPLES)
+        s[block_slice("sound")] = sound.take(_SOUND_SAMPLES)
         return s
 
     # Placements ---------------------------------------------------------------------------
@@ -345,7 +360,13 @@ class Playroom:
         if self.iteration % self.config.toy_replace_period == 0:
             self.experimenter.place_toys(self.rng)
         self.caregiver.place(self.physics, self.rng)
-        mujoco.mj_forward(self.physics.model.ptr, self.physics.data.ptr)
+        m, d = self.physics.model.ptr, self.physics.data.ptr
+        if isinstance(self.backend, ClosedForm):
+            # Positions are all the closed form reads: the full mj_forward (contacts,
+            # constraints, forces: 5 times the cost) runs when a stepped movement begins.
+            mujoco.mj_kinematics(m, d)
+        else:
+            mujoco.mj_forward(m, d)
         return events
 
     @property

@@ -11,6 +11,8 @@ by sample and event by event: change a rule in both forms here, and run it.
 
 from __future__ import annotations
 
+import functools
+
 import mujoco
 import numpy as np
 
@@ -37,7 +39,14 @@ class KinematicPhysics(PlayroomPhysics):
         self.step(nstep)
 
     def hand_position(self) -> np.ndarray:
-        return hand_positions(self.arm_angles()[:, None], self.config)[0]
+        # Between movements the arm rests: the last angles' answer is kept (tens of
+        # microseconds of small array operations saved at every read).
+        angles = self.arm_angles()
+        key = angles.tobytes()
+        if getattr(self, "_hand_for", None) != key:
+            self._hand = hand_positions(angles[:, None], self.config)[0]
+            self._hand_for = key
+        return self._hand.copy()
 
     def tracked_positions(self) -> np.ndarray:
         out = super().tracked_positions()
@@ -136,8 +145,14 @@ class KinematicGrasp(ClosedForm):
         self, joint_targets: np.ndarray, stick_pose: np.ndarray, toys: np.ndarray
     ) -> ArmMovement:
         config = self.config
-        hand = hand_positions(joint_targets, config)  # (N_STEPS, 2)
-        yaw = np.cumsum(joint_targets, axis=0)[-1] + config.arm_rest_offset  # (N_STEPS,)
+        # sim/kinematics.hand_positions' arithmetic, with the cosines and sines kept: the held
+        # stick points along the last segment's angle, whose cosine and sine are among them.
+        absolute = np.cumsum(joint_targets, axis=0) + config.arm_rest_offset  # (3, N_STEPS)
+        cos, sin = np.cos(absolute), np.sin(absolute)
+        lengths = self._lengths
+        hand = np.empty((N_STEPS, 2))
+        hand[:, 0] = (lengths * cos).sum(axis=0)
+        hand[:, 1] = (lengths * sin).sum(axis=0)
         positions = np.empty((N_STEPS, 2 + len(TOYS), 2))
         positions[:, 0] = hand
         positions[:, 1] = stick_pose[:2]
@@ -145,14 +160,11 @@ class KinematicGrasp(ClosedForm):
         events: list[ev.Event] = []
         free = np.ones(len(TOYS), dtype=bool)
         on_stick = None  # the toy on the stick's tip
-        # Until the hand takes something nothing moves, so every distance is to a still object.
-        near = np.empty((N_STEPS, 1 + len(TOYS)), dtype=bool)
-        near[:, 0] = np.hypot(*(stick_pose[:2] - hand).T) < config.grasp_distance
-        for i in range(len(TOYS)):
-            near[:, 1 + i] = np.hypot(*(toys[i] - hand).T) < config.grasp_distance
-        grab_steps = np.flatnonzero(near.any(axis=1))
-        k = int(grab_steps[0]) if grab_steps.size else N_STEPS  # 0-based: control step k + 1
-        first = int(np.argmax(near[k])) if k < N_STEPS else -1  # the stick first, then the toys
+        # Until the hand takes something nothing moves, so every distance is to a still object:
+        # (N_STEPS, stick and toys) at once.
+        offsets = positions[:, 1:] - hand[:, None, :]
+        near = np.hypot(offsets[..., 0], offsets[..., 1]) < config.grasp_distance
+        k, first = _first_near(near)  # 0-based step k: control step k + 1
         if config.catch_rule == "study" and not (k == 0 and first == 0):
             # The lying stick's tip catches a toy at the first step or never (nothing moves
             # before the hand takes something), after the hand's pick of that step, if any.
@@ -169,9 +181,7 @@ class KinematicGrasp(ClosedForm):
                 events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
                 if k > 0:  # the hand's first grasp comes later: the caught toy is not free
                     near[:, 1:] &= free
-                    grab_steps = np.flatnonzero(near.any(axis=1))
-                    k = int(grab_steps[0]) if grab_steps.size else N_STEPS
-                    first = int(np.argmax(near[k])) if k < N_STEPS else -1
+                    k, first = _first_near(near)
         final_stick = np.array(stick_pose, dtype=float)
         if k == N_STEPS:
             return ArmMovement(positions, final_stick, events, None)
@@ -182,23 +192,27 @@ class KinematicGrasp(ClosedForm):
             return ArmMovement(positions, final_stick, _in_step_order(events), TOYS[toy])
         events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
         positions[k:, 1] = hand[k:]
-        final_stick = np.array([*hand[-1], yaw[-1]])
+        final_stick = np.array([*hand[-1], absolute[-1, -1]])
         # The held stick points along the hand: its tip carries a toy caught before, or catches
         # the first toy within reach.
-        tip = hand[k:] + config.stick_length * np.stack([np.cos(yaw[k:]), np.sin(yaw[k:])], 1)
+        tip = np.empty((N_STEPS - k, 2))
+        tip[:, 0] = hand[k:, 0] + config.stick_length * cos[-1, k:]
+        tip[:, 1] = hand[k:, 1] + config.stick_length * sin[-1, k:]
         if on_stick is not None:
             positions[k:, 2 + on_stick] = tip
             return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
-        caught = np.empty((N_STEPS - k, len(TOYS)), dtype=bool)
-        for i in range(len(TOYS)):
-            caught[:, i] = (np.hypot(*(toys[i] - tip).T) < config.catch_distance) & free[i]
-        catch_steps = np.flatnonzero(caught.any(axis=1))
-        if catch_steps.size:
-            c = int(catch_steps[0])
-            toy = int(np.argmax(caught[c]))
+        offsets = toys[None, :, :] - tip[:, None, :]
+        caught = (np.hypot(offsets[..., 0], offsets[..., 1]) < config.catch_distance) & free
+        c, toy = _first_near(caught)
+        if c < len(caught):
             positions[k + c :, 2 + toy] = tip[c:]
             events.append(ev.Event(ev.TOY_CAUGHT, k + c + 1, obj=TOYS[toy], by="stick"))
         return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
+
+    @functools.cached_property
+    def _lengths(self) -> np.ndarray:
+        """(3, 1) the segment lengths, as sim/kinematics.hand_positions shapes them."""
+        return np.asarray(self.config.segment_lengths, dtype=float).reshape(3, 1)
 
     # Vocal movements: the resting hand's grab, stepped and in closed form -----------------
     def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
@@ -247,6 +261,16 @@ class KinematicGrasp(ClosedForm):
         """The handle lies beyond the arm's length plus the grasp distance."""
         cfg = self.config
         return float(np.hypot(*physics.stick_handle())) > cfg.arm_length + cfg.grasp_distance
+
+
+def _first_near(near: np.ndarray) -> tuple[int, int]:
+    """(first row with a True, first True column in it) of a (steps, objects) mask; (number of
+    rows, -1) when there is none. Columns are in priority order (the stick before the toys)."""
+    rows = np.flatnonzero(near.any(axis=1))
+    if rows.size == 0:
+        return len(near), -1
+    k = int(rows[0])
+    return k, int(np.argmax(near[k]))
 
 
 def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:
