@@ -47,6 +47,7 @@ class InterestModel:
         # Only the model just attempted changes its progress: cached, so that choosing costs
         # no pass over the histories.
         self._progress = np.zeros(n_models)
+        self._full_window_positions: dict[int, np.ndarray] = {}
 
     @property
     def attempts(self) -> np.ndarray:
@@ -84,10 +85,24 @@ class InterestModel:
         half = min(self.window, n // 2)
         if half == 0:
             return 0.0
-        # Positions of the last 2 * half attempts in the ring buffer, oldest first.
-        positions = np.arange(n - 2 * half, n) % (2 * self.window)
-        recent = self._competences[model, positions]
-        return abs(float(recent[half:].mean()) - float(recent[:half].mean()))
+        # The last 2 * half attempts in the ring buffer, oldest first.
+        recent = self._competences[model, self._ring_positions(n, half)]
+        # ndarray.mean's own arithmetic (NumPy's sum, then the division), without its overhead.
+        newer = float(np.add.reduce(recent[half:])) / half
+        older = float(np.add.reduce(recent[:half])) / half
+        return abs(newer - older)
+
+    def _ring_positions(self, n: int, half: int) -> np.ndarray:
+        """Ring-buffer positions of attempts n - 2 half .. n - 1. With full windows (all but a
+        model's first 2 W attempts) they depend only on n mod 2 W: kept once made."""
+        ring = 2 * self.window
+        if half < self.window:
+            return np.arange(n - 2 * half, n) % ring
+        positions = self._full_window_positions.get(n % ring)
+        if positions is None:
+            positions = np.arange(n - ring, n) % ring
+            self._full_window_positions[n % ring] = positions
+        return positions
 
     def state_dict(self) -> dict[str, np.ndarray]:
         return {"competences": self._competences.copy(), "attempts": self._attempts.copy()}

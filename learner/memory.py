@@ -108,9 +108,14 @@ class NearestNeighbourMemory:
         if self._n == self._rows.shape[0]:
             self._reserve(self._n + 1)
         n = self._n
-        self._rows[n] = row
+        stored = self._rows[n]
+        stored[:] = row
         self._n = n + 1
-        self._code_from(n)
+        max_abs = float(np.abs(stored).max())
+        if max_abs > self._scale:  # beyond the grid: widened, every row re-coded
+            self._code_from(n)
+        else:  # _code_from's arithmetic for one row
+            self._codes[:, n] = np.rint(stored * (CODE_MAX / self._scale))
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""
