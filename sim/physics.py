@@ -112,6 +112,14 @@ class PlayroomPhysics(dm_mujoco.Physics):
             [[m.jnt_dofadr[joint(f"{o}_{a}")] for a in ("x", "y", "yaw")] for o in OBJECTS]
         )
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
+        # Flat views of the position arrays and the flat indices of the tracked x, y values:
+        # one `take` each reads them (read every control step; fancy indexing of the 2-D
+        # arrays cost several times more). The views live as long as this data.
+        d = self._mj_data
+        self._site_xpos_flat = d.site_xpos.reshape(-1)
+        self._xpos_flat = d.xpos.reshape(-1)
+        self._hand_handle_flat = (3 * self._hand_handle_sites[:, None] + [0, 1]).ravel()
+        self._toys_flat = (3 * self.toy_bodies[:, None] + [0, 1]).ravel()
 
     def _reload_from_data(self, data) -> None:
         super()._reload_from_data(data)
@@ -124,11 +132,10 @@ class PlayroomPhysics(dm_mujoco.Physics):
 
     def tracked_positions(self) -> np.ndarray:
         """(5, 2) positions of hand, stick handle, toy1, toy2, toy3: the sensory objects."""
-        d = self._mj_data
-        out = np.empty((5, 2))
-        out[:2] = d.site_xpos[self._hand_handle_sites, :2]
-        out[2:] = d.xpos[self.toy_bodies, :2]
-        return out
+        out = np.empty(10)
+        out[:4] = self._site_xpos_flat.take(self._hand_handle_flat)
+        out[4:] = self._xpos_flat.take(self._toys_flat)
+        return out.reshape(5, 2)
 
     def hand_angle(self) -> float:
         """Orientation of the last segment in the plane (rad), as the protocol defines it."""
