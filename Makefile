@@ -96,11 +96,10 @@ test: lint
 	$(PYTEST)
 
 # Another x86-64 CPU class, emulated on this one (../shared/notes.md): on a CPU with AVX-512,
-# NumPy's AVX-512 kernels off and OpenBLAS's Haswell kernel (an AVX2 machine); without it,
-# NumPy's AVX2 kernels off and OpenBLAS's Sandybridge kernel (an older AVX machine).
-OTHER_CPU = $(shell if grep -qw avx512f /proc/cpuinfo 2>/dev/null; \
-	then echo 'NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL AVX512_SPR" OPENBLAS_CORETYPE=Haswell'; \
-	else echo 'NPY_DISABLE_CPU_FEATURES=X86_V3 OPENBLAS_CORETYPE=Sandybridge'; fi)
+# NumPy's AVX-512 kernels off, OpenBLAS's Haswell kernel and numba compiling for Haswell (an
+# AVX2 machine); without it, the same one class older (an AVX machine). The settings come from
+# experiments/bench/cpu_classes.py, which `playroom bench emulated` uses too.
+OTHER_CPU = $(shell $(BIN)/python -m experiments.bench.cpu_classes)
 
 ## test-slow: the longer checks marked `slow`, then the whole suite with another CPU emulated
 test-slow: $(INSTALLED)

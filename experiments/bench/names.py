@@ -3,4 +3,4 @@ lists them in its help without loading a simulator (experiments/bench/sections.p
 
 from __future__ import annotations
 
-SECTION_NAMES = ("trial", "learner", "world", "tracking", "voice", "render")
+SECTION_NAMES = ("trial", "learner", "world", "tracking", "voice", "render", "emulated")

@@ -20,9 +20,14 @@ from models.layout import ARM_DIM, N_STEPS, SAMPLE_INDICES
 from sim import Playroom
 from sim.physics import CONTROL_SUBSTEPS
 
-# Targets of the trial and learner figures (ratios to 500 bare mj_step; ms).
-TRIAL_TARGETS = {"kinematic": 0.25, "physical": 1.6}
+# Targets of the trial and learner figures (ratios to 500 bare mj_step; ms; s; minutes), on
+# both CPU classes (experiments/bench/cpu_classes.py).
+TRIAL_TARGETS = {"kinematic": 0.25, "physical": 1.4}
 LEARNER_TARGET_MS = 0.25
+TRIAL_80000_TARGET_S = 20.0  # a kinematic trial of 80000 iterations on one core
+REPLICATION_TARGET_MIN = 20.0  # the replication profile on 2 cores
+# The sections measured again under the emulated CPU class, in a second process.
+EMULATED_SECTIONS = ("trial", "learner")
 LEARNER_SIZES = (10000, 40000, 80000)
 
 
@@ -195,8 +200,19 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
     growth = max(0.0, costs[40000] - costs[10000])
     spec = load_spec("paper")
     trial_s = {g: spec.iterations * (per_iteration[g] + growth) for g in spec.grasps}
-    yield "kinematic_trial_80000_projected", trial_s["kinematic"], "s (target < 60, one core)"
+    yield (
+        "kinematic_trial_80000_projected",
+        trial_s["kinematic"],
+        f"s (target <= {TRIAL_80000_TARGET_S:g}, one core)",
+    )
     yield "physical_trial_80000_projected", trial_s["physical"] / 3600, "h (one core)"
+    replication = load_spec("replication")
+    n_trials = len(replication.seeds) * len(replication.babbling) * len(replication.grasps)
+    yield (
+        "replication_profile_on_2_cores",
+        n_trials * trial_s["kinematic"] / 2 / 60,
+        f"minutes (projected, target < {REPLICATION_TARGET_MIN:g})",
+    )
     total = sum(trial_s[g] for g in spec.grasps) * len(spec.seeds) * len(spec.babbling)
     for cores in (1, 16, 100):
         yield f"paper_profile_on_{cores}_cores", total / cores / 3600, "h (running, projected)"
@@ -208,6 +224,51 @@ def render_section() -> Iterator[tuple[str, float, str]]:
     from experiments.bench.render import render_figures
 
     yield from render_figures()
+
+
+def emulated_section(
+    sections: tuple[str, ...] = EMULATED_SECTIONS,
+) -> Iterator[tuple[str, float, str]]:
+    """The trial and learner sections again, in a process that emulates the other CPU class
+    (or, where that cannot be emulated, the next older one): figures named emulated_<class>_."""
+    import subprocess
+    import sys
+
+    from experiments.bench import cpu_classes
+
+    cpu = cpu_classes.emulated_class()
+    print(f"emulated: {cpu.description}: {cpu_classes.shell_assignments(cpu)}", flush=True)
+    if cpu_classes.this_class() is cpu_classes.WITHOUT_AVX512:
+        print("emulated: (a CPU without AVX-512 cannot emulate one with it)", flush=True)
+    command = [sys.executable, "-m", "experiments.cli.main", "bench", *sections]
+    env = cpu_classes.emulation_environment(cpu)
+    with subprocess.Popen(command, env=env, stdout=subprocess.PIPE, text=True) as child:
+        assert child.stdout is not None  # asked for with stdout=PIPE
+        for line in child.stdout:
+            name, _, rest = line.partition(": ")
+            value, _, unit = rest.strip().partition(" ")
+            if name.startswith("machine"):
+                print(f"emulated {line.strip()}", flush=True)
+                continue
+            yield f"emulated_{cpu.name}_{name}", float(value), unit
+    if child.returncode != 0:
+        raise RuntimeError(f"the emulated bench failed (exit code {child.returncode})")
+
+
+def machine_line() -> str:
+    """Which machine and which kernels the figures come from."""
+    from experiments import provenance
+    from experiments.bench import cpu_classes
+
+    blas = ", ".join(f"{b['library']} {b['kernel']}" for b in provenance.blas_record())
+    simd = provenance.simd_record()
+    found = set(simd["dispatched"]) | set(simd["baseline"])
+    top = [f for f in ("X86_V4", "X86_V3", "X86_V2") if f in found]
+    return (
+        f"machine: {provenance.cpu_model()} ({'with' if cpu_classes.has_avx512() else 'without'} "
+        f"AVX-512); NumPy {top[0] if top else 'baseline'}; {blas}; numba "
+        f"{provenance.numba_target()}"
+    )
 
 
 def _peak_rss_mb() -> float:
@@ -223,6 +284,7 @@ SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "tracking": tracking_figures,
     "voice": voice_figures,
     "render": render_section,
+    "emulated": emulated_section,
 }
 
 # The command line's list (experiments/bench/names.py) names exactly these, in this order.
@@ -232,6 +294,7 @@ if tuple(SECTIONS) != SECTION_NAMES:
 
 def run_bench(sections: list[str] | None = None) -> None:
     """Print every figure of the chosen sections (all by default)."""
+    print(machine_line(), flush=True)
     for name in sections or list(SECTIONS):
         for figure, value, unit in SECTIONS[name]():
             print(f"{figure}: {value:.4g} {unit}", flush=True)

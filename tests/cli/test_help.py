@@ -38,7 +38,7 @@ def test_every_option_of_every_command_has_help():
         ("render", ["(default: 640x480)", "(default: 50.0)", "(default: top)"]),
         ("eval", ["(default: 100)"]),
         ("batch", ["smoke", "paper", "dashboard", "--set"]),
-        ("bench", ["trial, learner, world, tracking, voice, render"]),
+        ("bench", ["trial, learner, world, tracking, voice, render, emulated"]),
         ("say", ["{oey,uye,iuo,eyu,eou,yeo}"]),
         ("report", ["study_reference_commands"]),
     ],
