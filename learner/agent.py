@@ -125,7 +125,8 @@ class Agent:
             else:
                 m, _ = model.inverse(context, goal)
                 m += self.rng.normal(0.0, cfg.exploration_sigma, model.motor_dim)
-                np.clip(m, cfg.motor_low, cfg.motor_high, out=m)
+                # np.clip's values, in place, without its Python wrapper (every iteration).
+                np.minimum(np.maximum(m, cfg.motor_low, out=m), cfg.motor_high, out=m)
                 inferred = True
             proposal = Proposal(spec.motor_space, m, k, goal, kind, inferred)
         self._pending = proposal
@@ -160,7 +161,7 @@ class Agent:
             self._pending = None
             return
         if cfg.clip_sensory:
-            s = s.clip(-1.0, 1.0)  # np.clip's stubs would type s as any array-like again
+            s = _unit_clipped(s)
         m = proposal.m
         changed = changed_blocks(context, s, cfg.change_tolerance, cfg.storing_rule)
         for k in self._by_space[proposal.motor_space]:
@@ -187,7 +188,7 @@ class Agent:
             return None
         s = np.asarray(s, dtype=np.float64)
         if self.config.clip_sensory:
-            s = s.clip(-1.0, 1.0)
+            s = _unit_clipped(s)
         return s[self.models[proposal.model].sensory_slice].copy()
 
     def interests(self) -> np.ndarray:
@@ -307,6 +308,11 @@ class Agent:
 
     def _check_context(self, context: ArrayLike) -> np.ndarray:
         return _checked_vector(context, CONTEXT_DIM, "context")
+
+
+def _unit_clipped(v: np.ndarray) -> np.ndarray:
+    """v.clip(-1, 1)'s values, without its Python wrapper (twice every iteration)."""
+    return np.minimum(np.maximum(v, -1.0), 1.0)
 
 
 def _checked_vector(value: ArrayLike, dim: int, what: str) -> np.ndarray:

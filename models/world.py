@@ -7,8 +7,30 @@ video drive either through `act`, and nothing else dispatches on the motor space
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
+
+
+class _ComputedOnRead:
+    """A dataclass field that may be given a function of no arguments instead of its value:
+    the function runs at the first read, and its value is kept. For a value that costs time
+    and that most callers never read."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._slot = f"_{name}"
+
+    def __get__(self, obj: Any, owner: type | None = None) -> Any:
+        if obj is None:  # the dataclass asks for the field's default
+            return None
+        value = obj.__dict__[self._slot]
+        if isinstance(value, Callable):  # type: ignore[arg-type]
+            value = value()
+            obj.__dict__[self._slot] = value
+        return value
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self._slot] = value
 
 
 @dataclass
@@ -19,14 +41,15 @@ class Feedback:
     5 x then 5 y at the sample steps) and sound (5 normalised log2 F1 then 5 log2 F2).
     events: what happened, in step order (the world's own event objects).
     positions: (50, 5, 2) the tracked objects after every control step, if the world has them.
-    sound: (50, 2) the sound sensor after every control step, if the world has it.
+    sound: (50, 2) the sound sensor after every control step, if the world has it (a world
+    may pass a function that computes it: it then runs when `sound` is first read).
     """
 
     motor_space: str
     s: Any
     events: list = field(default_factory=list)
     positions: Any = None
-    sound: Any = None
+    sound: Any = _ComputedOnRead()
 
     def kinds(self) -> list[str]:
         return [e.kind for e in self.events]

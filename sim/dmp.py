@@ -131,7 +131,9 @@ def arm_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.nda
     per_joint = np.asarray(m, dtype=float).reshape(N_JOINTS, ARM_BASIS_FUNCTIONS + 1)
     weights = per_joint[:, :-1] * config.dmp_weight_scale
     traj = rollout(np.zeros(N_JOINTS), per_joint[:, -1], weights, N_STEPS, config.dmp)
-    return np.pi * np.clip(traj, -1.0, 1.0)
+    # np.clip's values (min(max(x, lo), hi)) without its Python wrapper: an arm command's
+    # and a voice command's trajectory are bounded every iteration.
+    return np.pi * np.minimum(np.maximum(traj, -1.0), 1.0)
 
 
 def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.ndarray:
@@ -142,4 +144,4 @@ def voice_trajectory(m: np.ndarray, config: WorldConfig = DEFAULT_WORLD) -> np.n
     per_art = np.asarray(m, dtype=float).reshape(N_ARTICULATORS, VOICE_BASIS_FUNCTIONS + 2)
     weights = per_art[:, 2:] * config.dmp_weight_scale
     traj = rollout(per_art[:, 0], per_art[:, 1], weights, N_STEPS, config.dmp)
-    return np.clip(traj, -1.0, 1.0)
+    return np.minimum(np.maximum(traj, -1.0), 1.0)  # np.clip's values, as above

@@ -51,6 +51,7 @@ def _sample_indices() -> tuple[np.ndarray, np.ndarray]:
 
 
 _OBJECT_SAMPLES, _SOUND_SAMPLES = _sample_indices()
+_SAMPLE_STEPS = np.array(SAMPLE_INDICES)
 
 
 class Playroom:
@@ -147,8 +148,19 @@ class Playroom:
         fallbacks = self.vocal_tract.n_fallbacks
         # The trajectory is finite and clipped to [-1, 1]: the tract's input checks
         # (trajectory_formants) would only repeat that.
-        formants = self.vocal_tract.frame_formants(articulators.T)
+        frames = articulators.T
         closed = self._closed_form()
+        at_samples = None if closed is None else self._sample_formants(frames)
+        if closed is not None and at_samples is not None:
+            # What the learner and the caregiver hear are the 5 sample steps: only those are
+            # computed now, the other steps when the feedback's `sound` is read.
+            formants = np.full((N_STEPS, 2), np.nan)
+            formants[_SAMPLE_STEPS] = at_samples
+            whole = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))  # noqa: E731
+            feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
+            feedback.sound = whole
+            return feedback
+        formants = self.vocal_tract.frame_formants(frames)
         if closed is not None:
             feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
         else:
@@ -156,6 +168,11 @@ class Playroom:
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
+
+    def _sample_formants(self, frames: np.ndarray) -> np.ndarray | None:
+        """(5, 2) formants of the sample steps, if the tract computes them for less than
+        every step (the same numbers: sim/vocal/voice.py)."""
+        return self.vocal_tract.frame_formants_at(frames, _SAMPLE_STEPS)
 
     @property
     def words(self) -> WordAssignment:
@@ -395,7 +412,7 @@ def _checked_command(m, dim: int, what: str) -> np.ndarray:
     arr = _checked_array(m, (dim,), what)
     if np.abs(arr).max() > 1.0 + RANGE_TOLERANCE:
         raise ValueError(f"{what} must lie in [-1, 1], max |value| is {np.abs(arr).max():.6g}")
-    return np.clip(arr, -1.0, 1.0)
+    return np.minimum(np.maximum(arr, -1.0), 1.0)  # np.clip's values, without its wrapper
 
 
 __all__ = ["Feedback", "Playroom"]

@@ -52,6 +52,9 @@ class VocalTract(Voice):
         self.n_fallbacks += int(np.size(ok) - np.count_nonzero(ok))
         return log2_hz
 
+    def frame_formants_at(self, artic: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
+        return None if self.exact else self.formant_map.at_rows(artic, rows)
+
     def vowel_targets(self) -> dict[str, np.ndarray]:
         """The speaker's own vowels (sim/vocal/words.py), not the study's Hz values."""
         return vowel_targets(self.config)

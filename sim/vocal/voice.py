@@ -62,6 +62,11 @@ class Voice(abc.ABC):
     def frame_formants(self, artic: np.ndarray) -> np.ndarray:
         """Checked articulator frames (..., 7) in [-1, 1] -> (..., 2) log2 Hz (F1, F2)."""
 
+    def frame_formants_at(self, artic: np.ndarray, rows: np.ndarray) -> np.ndarray | None:
+        """`frame_formants(artic)[rows]` where the tract computes some frames for less than
+        all (the same numbers); None where it computes every frame anyway."""
+        return None
+
     @abc.abstractmethod
     def vowel_targets(self) -> dict[str, np.ndarray]:
         """Vowel name -> (2,) log2 Hz (F1, F2): where this tract's words lie."""

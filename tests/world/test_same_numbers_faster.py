@@ -1,0 +1,45 @@
+"""The speed-ups of the learning loop give the numbers of the plain computation, to the last bit:
+the formant map's sample rows, and a feedback's sound computed when read."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_DIM
+from models.world import Feedback
+from sim import Playroom
+from sim.dmp import voice_trajectory
+from sim.vocal.formant_map import FormantMap
+
+
+def test_the_map_at_the_sample_rows_is_the_whole_map_s_rows() -> None:
+    formant_map = FormantMap.load()
+    rows = np.array(SAMPLE_INDICES)
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        frames = rng.uniform(-1.0, 1.0, (N_STEPS, 7))
+        np.testing.assert_array_equal(formant_map.at_rows(frames, rows), formant_map(frames)[rows])
+
+
+def test_a_sound_given_as_a_function_is_computed_once_when_read() -> None:
+    calls = []
+
+    def sound() -> np.ndarray:
+        calls.append(1)
+        return np.ones((N_STEPS, 2))
+
+    feedback = Feedback("voice", np.zeros(60), sound=sound)
+    assert calls == []
+    assert feedback.sound.shape == (N_STEPS, 2)
+    assert feedback.sound is feedback.sound and calls == [1]
+    assert Feedback("arm", np.zeros(60)).sound is None
+
+
+def test_a_vocal_movement_s_sound_is_the_tract_s_at_every_step() -> None:
+    room = Playroom("kinematic", seed=2)
+    for m in np.random.default_rng(4).uniform(-1.0, 1.0, (20, VOICE_DIM)):
+        feedback = room.act_voice(m)
+        frames = voice_trajectory(m, room.config).T
+        expected = room.task.normalised(room.vocal_tract.formants(frames))
+        np.testing.assert_array_equal(feedback.sound, expected)
+        np.testing.assert_array_equal(feedback.s[50:55], expected[list(SAMPLE_INDICES), 0])
