@@ -95,23 +95,30 @@ class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
 
+_EMPTY_ROW = {
+    "iteration": 0,
+    "motor_space": "",
+    "model": -1,
+    "stick_distance": 0.0,
+    "stick_grasped": False,
+    "stick_moved_by": "",
+    **{f"{toy}_moved_by": "" for toy in TOYS},
+    "word_recognised": "",
+    "caregiver_said": "",
+    "diverged": False,
+    "stick_returned": False,
+}
+
+
 def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
     """One row of the iterations log: what was tried, in what context (10,), and what happened.
     `stick_distance` is the handle's distance from the arm's base before the movement (m)."""
-    handle = context[list(context_indices("stick"))]
-    row = {
-        "iteration": iteration,
-        "motor_space": proposal.motor_space,
-        "model": -1 if proposal.model is None else int(proposal.model),
-        "stick_distance": float(np.hypot(*handle)),
-        "stick_grasped": False,
-        "stick_moved_by": "",
-        **{f"{toy}_moved_by": "" for toy in TOYS},
-        "word_recognised": "",
-        "caregiver_said": "",
-        "diverged": False,
-        "stick_returned": False,
-    }
+    x, y = context_indices("stick")
+    row = dict(_EMPTY_ROW)  # every event column, as if nothing happened
+    row["iteration"] = iteration
+    row["motor_space"] = proposal.motor_space
+    row["model"] = -1 if proposal.model is None else int(proposal.model)
+    row["stick_distance"] = float(np.hypot(context[x], context[y]))
     for e in feedback.events:
         if e.kind == ev.STICK_GRASPED:
             row["stick_grasped"] = True

@@ -143,7 +143,7 @@ class Voice(abc.ABC):
     def word_distances(self, features: np.ndarray) -> np.ndarray:
         """Euclidean distances (..., 6) from sound features (..., 10) to each word."""
         diff = np.asarray(features, float)[..., None, :] - self._word_features
-        return np.sqrt(np.sum(diff**2, axis=-1))
+        return np.sqrt(np.add.reduce(diff**2, axis=-1))  # np.sum's arithmetic, less overhead
 
     def recognise(self, features: np.ndarray) -> str | None:
         """The word the caregiver hears in a (10,) sound: the nearest word if within
