@@ -43,7 +43,7 @@ class PhysicalGrasp(GraspBackend):
         free = self._free_toy_mask()
         if self.hand_holds is None:
             touched = _partners(pairs, physics.hand_geom)
-            toys = np.isin(physics.toy_geoms, touched) & free
+            toys = _touched_toys(physics.toy_geoms, touched, free)
             if physics.handle_geom in touched:
                 self.hand_holds = "stick"
                 self._hold(physics, "hand_stick", "stick")
@@ -56,7 +56,7 @@ class PhysicalGrasp(GraspBackend):
                 events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
         # A stick lying on the table catches nothing: only a stick in the hand is a tool.
         if self.hand_holds == "stick" and self.stick_holds is None:
-            toys = np.isin(physics.toy_geoms, _partners(pairs, physics.tip_geom)) & free
+            toys = _touched_toys(physics.toy_geoms, _partners(pairs, physics.tip_geom), free)
             if toys.any():
                 self.stick_holds = int(np.argmax(toys))
                 toy = TOYS[self.stick_holds]
@@ -137,6 +137,12 @@ class PhysicalGrasp(GraspBackend):
         return nearest > self.config.arm_length + contact
 
 
-def _partners(pairs: np.ndarray, geom: int) -> np.ndarray:
-    """Geoms in contact with `geom`, from (n, 2) contact pairs."""
-    return np.concatenate([pairs[pairs[:, 0] == geom, 1], pairs[pairs[:, 1] == geom, 0]])
+def _partners(pairs: np.ndarray, geom: int) -> set[int]:
+    """Geoms in contact with `geom`, from (n, 2) contact pairs (a handful: in plain Python, as
+    this runs at every control step, faster than NumPy's masks)."""
+    return {b if a == geom else a for a, b in pairs.tolist() if geom in (a, b)}
+
+
+def _touched_toys(toy_geoms: np.ndarray, touched: set[int], free: np.ndarray) -> np.ndarray:
+    """(3,) bool: the free toys whose geom is among `touched`."""
+    return np.array([g in touched for g in toy_geoms.tolist()]) & free
