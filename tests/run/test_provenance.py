@@ -72,6 +72,7 @@ def _elsewhere(record: dict) -> dict:
 # The record ----------------------------------------------------------------------------------
 def test_the_record_holds_this_machines_real_values(monkeypatch):
     monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    monkeypatch.delenv("NUMBA_CPU_NAME", raising=False)  # set where another CPU is emulated
     record = machine_record()
     versions = record["versions"]
     assert versions["numpy"] == np.__version__
