@@ -12,8 +12,6 @@ from models.layout import (
     N_ARTICULATORS,
     N_JOINTS,
     N_STEPS,
-    SAMPLE_INDICES,
-    SENSORY_DIM,
     TOYS,
     TRACKED_OBJECTS,
     VOICE_DIM,
@@ -23,6 +21,7 @@ from models.presets import DEFAULT_PRESET
 from models.world import Feedback
 from sim import events as ev
 from sim.caregiver import Caregiver, WordAssignment
+from sim.commands import checked_array, checked_command
 from sim.config import WorldConfig, world_preset
 from sim.dm_control_import import control
 from sim.dmp import arm_trajectory, voice_trajectory
@@ -32,26 +31,10 @@ from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import backend_class
 from sim.model_edits import ModelEdits
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
+from sim.sensory import SAMPLE_STEPS, sensory_from
 from sim.task import ARM, VOICE, MovementStepper, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.registry import make_tract
-
-# Commands may exceed [-1, 1] by this much (float round-off) before they are refused.
-RANGE_TOLERANCE = 1e-9
-
-
-def _sample_indices() -> tuple[np.ndarray, np.ndarray]:
-    """Flat indices into (N_STEPS, 5, 2) positions and (N_STEPS, 2) sound of s's values: per
-    object its 5 x then its 5 y samples, then the sound's 5 F1 then 5 F2 samples."""
-    idx = list(SAMPLE_INDICES)
-    steps = np.arange(N_STEPS * len(TRACKED_OBJECTS) * 2).reshape(N_STEPS, -1, 2)
-    objects = steps[idx].transpose(1, 2, 0).ravel()
-    sound = np.arange(N_STEPS * 2).reshape(N_STEPS, 2)[idx].T.ravel()
-    return objects, sound
-
-
-_OBJECT_SAMPLES, _SOUND_SAMPLES = _sample_indices()
-_SAMPLE_STEPS = np.array(SAMPLE_INDICES)
 
 
 class Playroom:
@@ -125,7 +108,7 @@ class Playroom:
         Afterwards the caregiver says the name of the toy in the hand, or else a random
         distractor: her word is the sound block s[50:60].
         """
-        m = _checked_command(m, ARM_DIM, "arm command")
+        m = checked_command(m, ARM_DIM, "arm command")
         targets = arm_trajectory(m, self.config)  # (3, N_STEPS)
         closed = self._closed_form()
         if closed is not None:
@@ -141,7 +124,7 @@ class Playroom:
         name in it, she brings that toy toward the midpoint between her and the arm's base
         during the same 50 steps, as in the study.
         """
-        m = _checked_command(m, VOICE_DIM, "voice command")
+        m = checked_command(m, VOICE_DIM, "voice command")
         articulators = voice_trajectory(m, self.config)  # (7, n_steps)
         actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
         actions[:, N_JOINTS:] = articulators.T
@@ -150,12 +133,14 @@ class Playroom:
         # (trajectory_formants) would only repeat that.
         frames = articulators.T
         closed = self._closed_form()
-        at_samples = None if closed is None else self._sample_formants(frames)
+        at_samples = (
+            None if closed is None else self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
+        )
         if closed is not None and at_samples is not None:
             # What the learner and the caregiver hear are the 5 sample steps: only those are
             # computed now, the other steps when the feedback's `sound` is read.
             formants = np.full((N_STEPS, 2), np.nan)
-            formants[_SAMPLE_STEPS] = at_samples
+            formants[SAMPLE_STEPS] = at_samples
             whole = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))  # noqa: E731
             feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
             feedback.sound = whole
@@ -168,11 +153,6 @@ class Playroom:
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
-
-    def _sample_formants(self, frames: np.ndarray) -> np.ndarray | None:
-        """(5, 2) formants of the sample steps, if the tract computes them for less than
-        every step (the same numbers: sim/vocal/voice.py)."""
-        return self.vocal_tract.frame_formants_at(frames, _SAMPLE_STEPS)
 
     @property
     def words(self) -> WordAssignment:
@@ -191,7 +171,7 @@ class Playroom:
         Whatever is None stays where it is. The random placements go on as before afterwards.
         """
         checked = {
-            name: _checked_array(value, shape, name)
+            name: checked_array(value, shape, name)
             for name, value, shape in (
                 ("stick", stick, (3,)),
                 ("toys", toys, (len(TOYS), 2)),
@@ -353,20 +333,13 @@ class Playroom:
     ) -> Feedback:
         """The movement's feedback from (N_STEPS + 1, 5, 2) positions (row 0: the start) and
         (N_STEPS, 2) sound; then the room moves on to the next iteration."""
-        s = self._sensory(positions[1:], sound)
+        s = sensory_from(positions[1:], sound)
         if said is not None:
             s[block_slice("sound")], event = said
             events.append(event)
         self.iteration += 1
         events += self._place_for_iteration()
         return Feedback(movement, s, events, positions[1:], sound)
-
-    def _sensory(self, positions: np.ndarray, sound: np.ndarray) -> np.ndarray:
-        """(60,) from (50, 5, 2) positions and (50, 2) sound, sampled at the 5 steps."""
-        s = np.empty(SENSORY_DIM)
-        s[: _OBJECT_SAMPLES.size] = positions.take(_OBJECT_SAMPLES)
-        s[block_slice("sound")] = sound.take(_SOUND_SAMPLES)
-        return s
 
     # Placements ---------------------------------------------------------------------------
     def _place_for_iteration(self) -> list[ev.Event]:
@@ -390,29 +363,6 @@ class Playroom:
     def min_toy_gap(self) -> float:
         """Distance (m) between the centres of two toys placed side by side."""
         return self.experimenter.min_toy_gap
-
-
-def _checked_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:
-    """`value` as a finite float array of `shape`, or ValueError naming what is wrong."""
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{what} must be numbers: {exc}") from None
-    if arr.shape != shape:
-        raise ValueError(f"{what} must have shape {shape}, got {arr.shape}")
-    if not np.isfinite(arr).all():
-        bad = np.flatnonzero(~np.isfinite(arr.ravel()))
-        raise ValueError(f"{what} contains NaN or inf at flat indices {bad.tolist()}")
-    return arr
-
-
-def _checked_command(m, dim: int, what: str) -> np.ndarray:
-    """The command as a float array of shape (dim,) in [-1, 1], or ValueError naming what is
-    wrong."""
-    arr = _checked_array(m, (dim,), what)
-    if np.abs(arr).max() > 1.0 + RANGE_TOLERANCE:
-        raise ValueError(f"{what} must lie in [-1, 1], max |value| is {np.abs(arr).max():.6g}")
-    return np.minimum(np.maximum(arr, -1.0), 1.0)  # np.clip's values, without its wrapper
 
 
 __all__ = ["Feedback", "Playroom"]

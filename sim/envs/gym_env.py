@@ -24,11 +24,11 @@ import numpy as np
 from gymnasium import spaces
 
 from models.layout import ARM_DIM, VOICE_DIM
+from sim.commands import RANGE_TOLERANCE
 from sim.config import WorldConfig
 from sim.envs.dm_env_movement import PlayroomMovementEnv
 from sim.envs.world import SEED_BOUND, STUDY_ITERATIONS, checked_seed, event_dicts
 from sim.grasping.names import DEFAULT_GRASP
-from sim.playroom import RANGE_TOLERANCE
 from sim.task import ARM, VOICE
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 
