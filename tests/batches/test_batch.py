@@ -94,6 +94,7 @@ def test_rerun_resumes_an_unfinished_trial_from_its_checkpoint(tmp_path, client)
     assert 0 < timing["iterations"] < 1500
 
 
+@pytest.mark.slow  # 12 s: in make test-slow, to keep make test's pytest under 2 minutes
 def test_a_killed_worker_has_its_trial_retried_without_duplicates(tmp_path, client):
     spec = BatchSpec(
         grasps=("kinematic",),
