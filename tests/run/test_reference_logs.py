@@ -58,7 +58,7 @@ def test_a_kinematic_trial_gives_the_recorded_logs(fresh_logs):
     pd.testing.assert_frame_equal(logs["words"][list(words.columns)], words, rtol=1e-9)
 
 
-@pytest.mark.slow  # a 14-s physical trial: in make test-slow, to keep make test's pytest under 2 minutes
+@pytest.mark.slow  # a 14-s physical trial: in make test-slow (make test's pytest < 2 min)
 def test_a_physical_trial_makes_the_recorded_choices(fresh_logs):
     """Under random babbling the learner's choices are drawn from its own stream, whatever
     the contacts did: the same on every CPU."""
