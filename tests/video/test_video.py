@@ -340,6 +340,7 @@ def test_video_modules_leave_mujoco_gl_to_the_caller():
 
 
 # Replaying a trial ----------------------------------------------------------------------------
+@pytest.mark.slow  # 3.5-8 s each: in make test-slow, to keep make test's pytest under 2 minutes
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_replayed_trial_iterations_reproduce_the_logged_events(tmp_path, grasp, request):
     from experiments.analysis.logs import read_log
