@@ -31,6 +31,18 @@ def competence(goal: np.ndarray, reached: np.ndarray) -> float:
     return -float(np.sqrt(diff @ diff))
 
 
+def weighted_choice(rng: np.random.Generator, p: np.ndarray) -> int:
+    """`rng.choice(len(p), p=p)`: the same index from the same single draw, without its checks
+    of p (a third of a choice's cost, every iteration). p (n,) non-negative, summing to 1.
+
+    Generator.choice's own arithmetic: the normalised cumulative sum, searched for one uniform
+    draw. tests/learner/test_interest.py holds it to Generator.choice draw by draw.
+    """
+    cdf = p.cumsum()
+    cdf /= cdf[-1]
+    return int(cdf.searchsorted(rng.random(), side="right"))
+
+
 class InterestModel:
     """Competence history of each model, and the choice of the model to train."""
 
@@ -62,7 +74,7 @@ class InterestModel:
         total = progress.sum()
         if rng.random() < self.random_share or total <= 0.0:
             return int(rng.integers(self.n_models))
-        return int(rng.choice(self.n_models, p=progress / total))
+        return weighted_choice(rng, progress / total)
 
     def update(self, model: int, goal: np.ndarray, reached: np.ndarray) -> float:
         """Record the attempt of `model` at `goal` that reached `reached`; return its competence."""

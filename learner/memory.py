@@ -111,7 +111,7 @@ class NearestNeighbourMemory:
         stored = self._rows[n]
         stored[:] = row
         self._n = n + 1
-        max_abs = float(np.abs(stored).max())
+        max_abs = np.maximum.reduce(np.abs(stored))  # .max()'s answer, without its wrapper
         if max_abs > self._scale:  # beyond the grid: widened, every row re-coded
             self._code_from(n)
         else:  # _code_from's arithmetic for one row
@@ -138,17 +138,36 @@ class NearestNeighbourMemory:
 
         query (dim,). Raises ValueError if the memory is empty or the query is malformed.
         """
+        q = self._checked_query(query)
+        best, squared = self._search(q)
+        if squared is None:
+            squared = squared_distances(self._rows[best : best + 1], q)[0]
+        return best, float(np.sqrt(squared))
+
+    def nearest_index(self, query: ArrayLike) -> int:
+        """The index `nearest` answers, without computing its distance (the learner's inverse
+        query needs only the row)."""
+        return self._search(self._checked_query(query))[0]
+
+    def _checked_query(self, query: ArrayLike) -> np.ndarray:
         q = np.asarray(query, dtype=np.float64)
         if q.shape != (self._dim,):
             raise ValueError(f"query must have shape ({self._dim},), got {q.shape}")
-        if not np.isfinite(q).all():
+        if not np.logical_and.reduce(np.isfinite(q)):  # q.all()'s answer, without its wrapper
             raise ValueError("query has a NaN or infinite value")
-        n = self._n
-        if n == 0:
+        if self._n == 0:
             raise ValueError("nearest neighbour asked of an empty memory")
+        return q
+
+    def _search(self, q: np.ndarray) -> tuple[int, np.float64 | None]:
+        """(index of the nearest row, its squared distance, or None where a single candidate
+        made computing it unnecessary) for a checked query."""
+        n = self._n
         q_codes = q * (CODE_MAX / self._scale)
-        if not np.abs(q_codes).max() < _FAR_QUERY_CODES:
-            return brute_force_nearest(self._rows[:n], q)
+        if not np.maximum.reduce(np.abs(q_codes)) < _FAR_QUERY_CODES:
+            squared = squared_distances(self._rows[:n], q)
+            i = int(squared.argmin())  # as brute_force_nearest
+            return i, squared[i]
         eta, rho = candidate_limit(self._dim, math.sqrt(q_codes @ q_codes))
         count = screen_candidates(
             self._codes,
@@ -161,13 +180,12 @@ class NearestNeighbourMemory:
             self._candidates,
         )
         if count == 1:
-            best = int(self._candidates[0])
-            return best, float(np.sqrt(squared_distances(self._rows[best : best + 1], q)[0]))
+            return int(self._candidates[0]), None
         # In increasing index order, so argmin's first minimum is the lowest index of a tie.
         candidates = self._candidates[:count]
-        sq = squared_distances(self._rows[candidates], q)
-        j = int(np.argmin(sq))
-        return int(candidates[j]), float(np.sqrt(sq[j]))
+        squared = squared_distances(self._rows[candidates], q)
+        j = int(squared.argmin())
+        return int(candidates[j]), squared[j]
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """{'rows': (n, dim) float64 copy}: plain arrays for np.savez."""

@@ -81,14 +81,13 @@ def changed_blocks(
         # ndarray.mean's arithmetic (NumPy's sum, then the division), without its overhead.
         about_mean = xy - np.add.reduce(xy, axis=2, keepdims=True) / N_SAMPLES
         # np.linalg.norm(about_mean, axis=2)'s own arithmetic, without its overhead.
-        spread = np.sqrt(np.add.reduce(about_mean * about_mean, axis=2)).sum(axis=1)
+        spread = np.add.reduce(np.sqrt(np.add.reduce(about_mean * about_mean, axis=2)), axis=1)
         return spread > tolerance
     reference = np.zeros(SENSORY_DIM)
     reference[_CTX_DST] = context[_CTX_SRC]
     reference[_S_DST] = s[_S_SRC]
     moved = (np.abs(s - reference) > tolerance).reshape(len(SENSORY_BLOCKS), BLOCK_DIM)
-    # NumPy's stubs type any(axis=1) as a bool or an array: they do not know moved is 2-D.
-    return moved.any(axis=1)  # type: ignore[return-value]
+    return np.logical_or.reduce(moved, axis=1)  # moved.any(axis=1), without its wrapper
 
 
 class SensorimotorModel:
@@ -203,6 +202,14 @@ class SensorimotorModel:
         """
         i, distance = self._nearest_inverse(context, goal)
         return self._motor[i].copy(), distance
+
+    def inverse_command(self, context: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """`inverse`'s command alone, without computing the distance (the learning loop's
+        query), from a checked context (10,) and a float64 goal (10,)."""
+        if self._n == 0:
+            raise ValueError(f"model {self.spec.number} has no experience to invert")
+        key = np.concatenate((context[self.context_dims], goal))
+        return self._motor[self._inverse.nearest_index(key)].copy()
 
     def nearest_distance(self, context: np.ndarray, goal: ArrayLike) -> float:
         """Euclidean distance from (c_i, goal) to the nearest stored (c_i, s_i); inf if empty."""

@@ -11,7 +11,9 @@ from learner.memory import NearestNeighbourMemory, brute_force_nearest
 
 def _assert_brute_force(memory: NearestNeighbourMemory, rows: np.ndarray, queries) -> None:
     for q in queries:
-        assert memory.nearest(q) == brute_force_nearest(rows, q)
+        want = brute_force_nearest(rows, q)
+        assert memory.nearest(q) == want
+        assert memory.nearest_index(q) == want[0]  # the learning loop's query
 
 
 @pytest.mark.parametrize("dim", [1, 10, 18, 38])
