@@ -114,7 +114,9 @@ def rollout(
     start, end: (d,); weights: (d, n_bfs), already scaled. Returns (d, n_steps): the positions
     after each of the n_steps equal time steps of a movement lasting 1 (unitless time).
     """
-    weights = np.atleast_2d(np.asarray(weights, dtype=float))
+    weights = np.asarray(weights, dtype=float)
+    if weights.ndim != 2:  # a single DMP's weights (n_bfs,)
+        weights = np.atleast_2d(weights)
     inputs = np.empty((weights.shape[0], 2 + weights.shape[1]))  # C order, as column_stack's
     inputs[:, 0] = start
     inputs[:, 1] = end

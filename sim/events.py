@@ -58,9 +58,10 @@ def movement_events(
     # overhead, which was a third of this function's time.
     dx, dy = offsets[..., 0], offsets[..., 1]
     beyond = np.sqrt(dx * dx + dy * dy) > MOVED_DISTANCE  # (51, 4)
-    for row in np.flatnonzero(beyond.any(axis=0)):
+    # beyond.any(axis=0).nonzero(), without the wrappers of any() and np.flatnonzero.
+    for row in np.logical_or.reduce(beyond, axis=0).nonzero()[0]:
         name = TRACKED_OBJECTS[1 + row]
-        step = int(np.argmax(beyond[:, row]))
+        step = int(beyond[:, row].argmax())
         if name == "stick":
             by = "hand" if "stick" in grasped else "push"
             moved.append(Event(STICK_MOVED, step, obj="stick", by=by))

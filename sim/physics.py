@@ -120,6 +120,9 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._xpos_flat = d.xpos.reshape(-1)
         self._hand_handle_flat = (3 * self._hand_handle_sites[:, None] + [0, 1]).ravel()
         self._toys_flat = (3 * self.toy_bodies[:, None] + [0, 1]).ravel()
+        self._mocap_pos_flat = d.mocap_pos.reshape(-1)
+        self._handle_xy = slice(3 * self.handle_site, 3 * self.handle_site + 2)
+        self._caregiver_xy = slice(3 * self.caregiver_mocap, 3 * self.caregiver_mocap + 2)
         # The joints' addresses as slices where they are consecutive (they are in
         # models/playroom.xml): a slice reads and writes qpos several times faster.
         self._arm_qpos = _as_slice(self.arm_qpos)
@@ -142,6 +145,14 @@ class PlayroomPhysics(dm_mujoco.Physics):
         out[:4] = self._site_xpos_flat.take(self._hand_handle_flat)
         out[4:] = self._xpos_flat.take(self._toys_flat)
         return out.reshape(5, 2)
+
+    def context_positions(self) -> np.ndarray:
+        """(10,) stick handle, toy1, toy2, toy3 and caregiver x, y: the agent's context."""
+        out = np.empty(10)
+        out[:2] = self._site_xpos_flat[self._handle_xy]
+        out[2:8] = self._xpos_flat.take(self._toys_flat)
+        out[8:] = self._mocap_pos_flat[self._caregiver_xy]
+        return out
 
     def hand_angle(self) -> float:
         """Orientation of the last segment in the plane (rad), as the protocol defines it."""

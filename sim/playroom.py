@@ -36,6 +36,8 @@ from sim.task import ARM, VOICE, MovementStepper, PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.registry import make_tract
 
+_SOUND = block_slice("sound")  # where her word goes in s
+
 
 class Playroom:
     """The playroom world the learner talks to, built on the dm_control task.
@@ -89,8 +91,7 @@ class Playroom:
     # What the agent sees ------------------------------------------------------------------
     def context(self) -> np.ndarray:
         """(10,) stick handle x, y; toy1 x, y; toy2 x, y; toy3 x, y; caregiver x, y."""
-        p = self.physics
-        return np.concatenate([p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()])
+        return self.physics.context_positions()
 
     # What the agent does ------------------------------------------------------------------
     def act(self, motor_space: str, m: np.ndarray) -> Feedback:
@@ -335,7 +336,7 @@ class Playroom:
         (N_STEPS, 2) sound; then the room moves on to the next iteration."""
         s = sensory_from(positions[1:], sound)
         if said is not None:
-            s[block_slice("sound")], event = said
+            s[_SOUND], event = said
             events.append(event)
         self.iteration += 1
         events += self._place_for_iteration()

@@ -56,6 +56,8 @@ from experiments.run.trial_files import (
 )
 from models.layout import TOYS, block_slice
 
+_SOUND = block_slice("sound")
+
 
 class Trial:
     """A trial directory and the loop that fills it. It holds the directory's lock from its
@@ -271,7 +273,7 @@ class Trial:
         interests = self.agent.interests()  # what this iteration's model was chosen from
         proposal, context, feedback = self.agent.play(self.room)
         if proposal.motor_space == "voice":
-            sound = feedback.s[block_slice("sound")]
+            sound = feedback.s[_SOUND]
             distances = self.room.vocal_tract.word_distances(sound)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
         row = log_row(self.iteration, proposal, feedback, context)

@@ -147,12 +147,13 @@ class KinematicGrasp(ClosedForm):
         config = self.config
         # sim/kinematics.hand_positions' arithmetic, with the cosines and sines kept: the held
         # stick points along the last segment's angle, whose cosine and sine are among them.
-        absolute = np.cumsum(joint_targets, axis=0) + config.arm_rest_offset  # (3, N_STEPS)
+        absolute = joint_targets.cumsum(axis=0) + config.arm_rest_offset  # (3, N_STEPS)
         cos, sin = np.cos(absolute), np.sin(absolute)
         lengths = self._lengths
         hand = np.empty((N_STEPS, 2))
-        hand[:, 0] = (lengths * cos).sum(axis=0)
-        hand[:, 1] = (lengths * sin).sum(axis=0)
+        # ndarray.sum's arithmetic (np.add.reduce), without its Python wrapper.
+        hand[:, 0] = np.add.reduce(lengths * cos, axis=0)
+        hand[:, 1] = np.add.reduce(lengths * sin, axis=0)
         positions = np.empty((N_STEPS, 2 + len(TOYS), 2))
         positions[:, 0] = hand
         positions[:, 1] = stick_pose[:2]
@@ -174,8 +175,8 @@ class KinematicGrasp(ClosedForm):
                 [np.cos(stick_pose[2]), np.sin(stick_pose[2])]
             )
             caught = (np.hypot(*(toys - lying_tip).T) < config.catch_distance) & free
-            if caught.any():
-                on_stick = int(np.argmax(caught))
+            if np.logical_or.reduce(caught):
+                on_stick = int(caught.argmax())
                 positions[:, 2 + on_stick] = lying_tip
                 free[on_stick] = False
                 events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
@@ -270,11 +271,12 @@ class KinematicGrasp(ClosedForm):
 def _first_near(near: np.ndarray) -> tuple[int, int]:
     """(first row with a True, first True column in it) of a (steps, objects) mask; (number of
     rows, -1) when there is none. Columns are in priority order (the stick before the toys)."""
-    rows = np.flatnonzero(near.any(axis=1))
+    # np.flatnonzero(near.any(axis=1)), without the Python wrappers (twice per movement).
+    rows = np.logical_or.reduce(near, axis=1).nonzero()[0]
     if rows.size == 0:
         return len(near), -1
     k = int(rows[0])
-    return k, int(np.argmax(near[k]))
+    return k, int(near[k].argmax())
 
 
 def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:

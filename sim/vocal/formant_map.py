@@ -49,7 +49,7 @@ class FormantMap:
         for w, b in zip(self.weights[:-1], self.biases[:-1], strict=True):
             z = h @ w
             z += b
-            h = np.zeros_like(z)
+            h = np.zeros(z.shape)
             h[rows] = np.tanh(z[rows])
         return ((h @ self.weights[-1] + self.biases[-1]) * self.y_std + self.y_mean)[rows]
 

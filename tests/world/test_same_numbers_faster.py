@@ -1,5 +1,5 @@
 """The speed-ups of the learning loop give the numbers of the plain computation, to the last bit:
-the formant map's sample rows, and a feedback's sound computed when read."""
+the formant map's sample rows, a feedback's sound computed when read, the context read at once."""
 
 from __future__ import annotations
 
@@ -43,3 +43,13 @@ def test_a_vocal_movement_s_sound_is_the_tract_s_at_every_step() -> None:
         expected = room.task.normalised(room.vocal_tract.formants(frames))
         np.testing.assert_array_equal(feedback.sound, expected)
         np.testing.assert_array_equal(feedback.s[50:55], expected[list(SAMPLE_INDICES), 0])
+
+
+def test_the_context_is_the_objects_positions_read_one_by_one() -> None:
+    for grasp in ("kinematic", "physical"):
+        room = Playroom(grasp, seed=5)
+        for m in np.random.default_rng(6).uniform(-1.0, 1.0, (15, 21)):
+            p = room.physics
+            expected = [p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()]
+            np.testing.assert_array_equal(room.context(), np.concatenate(expected))
+            room.act_arm(m)
