@@ -94,6 +94,7 @@ class Agent:
         self._n_heard = 0
         # Every distinct caregiver sound heard so far (the "all_heard" imitation pool).
         self._distinct_heard = np.zeros((0, BLOCK_DIM))
+        self._distinct_keys: set[tuple[float, ...]] = set()  # its rows, to look them up
         self._sound_slice = block_slice("sound")
         self._pending: Proposal | None = None
 
@@ -175,12 +176,11 @@ class Agent:
                 self.models[k].store(m, context, s)
         if proposal.model is not None:
             assert proposal.goal is not None  # propose() gives every model's proposal a goal
-            reached = self.outcome(proposal, s)
-            assert reached is not None  # a proposal with a model has an outcome
+            reached = s[self.models[proposal.model].sensory_slice]  # `outcome`, s clipped above
             self.interest.update(proposal.model, proposal.goal, reached)
         if proposal.motor_space == "arm":
             sound = s[self._sound_slice]
-            if np.any(np.abs(sound) > cfg.change_tolerance):  # she spoke
+            if np.logical_or.reduce(np.abs(sound) > cfg.change_tolerance):  # she spoke
                 self._hear(sound)
         self.t += 1
         self._pending = None
@@ -291,6 +291,7 @@ class Agent:
         self._n_heard = int(state["n_heard"])
         distinct = np.asarray(state.get("distinct_heard", np.zeros((0, BLOCK_DIM))), float)
         self._distinct_heard = distinct.reshape(-1, BLOCK_DIM).copy()
+        self._distinct_keys = {tuple(row) for row in self._distinct_heard.tolist()}
         self._pending = None
 
     # ------------------------------------------------------------------ helpers
@@ -299,7 +300,10 @@ class Agent:
         """Remember a caregiver sound: in the ring buffer of recent sounds, or, with the
         "all_heard" pool, among the distinct sounds heard so far (never forgotten)."""
         if self.config.imitation_pool == "all_heard":
-            if not (self._distinct_heard == sound).all(axis=1).any():
+            # As tuples of Python floats, rows compare as NumPy's == does (0.0 == -0.0).
+            key = tuple(sound.tolist())
+            if key not in self._distinct_keys:
+                self._distinct_keys.add(key)
                 self._distinct_heard = np.vstack([self._distinct_heard, sound])
         self._heard[self._n_heard % len(self._heard)] = sound
         self._n_heard += 1

@@ -149,7 +149,11 @@ class SensorimotorModel:
         c_i = context[self.context_dims]
         self._count_outcome(s[self.sensory_slice])
         self._inverse.append(np.concatenate((c_i, s[self.sensory_slice])), checked=True)
-        self._append_motor(m[None, :])
+        if self._n == len(self._motor):  # full: grown by the general path
+            self._append_motor(m[None, :])
+        else:  # _append_motor's effect for one row, every iteration
+            self._motor[self._n] = m
+            self._n += 1
         if self._forward is not None:
             self._forward.append(np.concatenate((m, c_i)), checked=True)
 

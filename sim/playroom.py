@@ -127,8 +127,6 @@ class Playroom:
         """
         m = checked_command(m, VOICE_DIM, "voice command")
         articulators = voice_trajectory(m, self.config)  # (7, n_steps)
-        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-        actions[:, N_JOINTS:] = articulators.T
         fallbacks = self.vocal_tract.n_fallbacks
         # The trajectory is finite and clipped to [-1, 1]: the tract's input checks
         # (trajectory_formants) would only repeat that.
@@ -150,6 +148,8 @@ class Playroom:
         if closed is not None:
             feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
         else:
+            actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
+            actions[:, N_JOINTS:] = frames
             feedback = self._run(VOICE, actions, formants)
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
