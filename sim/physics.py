@@ -141,10 +141,19 @@ class PlayroomPhysics(dm_mujoco.Physics):
 
     def tracked_positions(self) -> np.ndarray:
         """(5, 2) positions of hand, stick handle, toy1, toy2, toy3: the sensory objects."""
-        out = np.empty(10)
-        out[:4] = self._site_xpos_flat.take(self._hand_handle_flat)
-        out[4:] = self._xpos_flat.take(self._toys_flat)
-        return out.reshape(5, 2)
+        out = np.empty((5, 2))
+        self._read_tracked(out)
+        return out
+
+    def write_tracked_positions(self, out: np.ndarray) -> None:
+        """`tracked_positions()` written into `out`, a C-contiguous (5, 2) float64 array (a
+        movement's row: read at every control step)."""
+        self._read_tracked(out)
+
+    def _read_tracked(self, out: np.ndarray) -> None:
+        flat = out.reshape(-1)  # a view: out is contiguous
+        self._site_xpos_flat.take(self._hand_handle_flat, out=flat[:4])
+        self._xpos_flat.take(self._toys_flat, out=flat[4:])
 
     def context_positions(self) -> np.ndarray:
         """(10,) stick handle, toy1, toy2, toy3 and caregiver x, y: the agent's context."""

@@ -287,6 +287,7 @@ class Playroom:
             assert voice_formants is not None  # act_voice passes them
             events = self.caregiver.hear(p, voice_formants)
         warnings = p.warning_counts()
+        task = self.task
         try:
             for k in range(n):
                 if self.step_observers:  # through the dm_control environment, observed
@@ -296,12 +297,13 @@ class Playroom:
                     for observer in self.step_observers:
                         observer(k + 1, obs)
                 else:  # the same step, reading only what the feedback needs
-                    self.task.before_step(actions[k], p)
+                    task.before_step(actions[k], p)
                     p.advance(CONTROL_SUBSTEPS)
-                    self.task.after_step(p)
-                    positions[k + 1] = p.tracked_positions()
-                    sound[k] = self.task.sound
-                events += self.task.step_events
+                    task.after_step(p)
+                    p.write_tracked_positions(positions[k + 1])
+                    sound[k] = task.sound
+                if task.step_events:
+                    events += task.step_events
             if (p.warning_counts() > warnings).any() or not np.isfinite(positions).all():
                 raise control.PhysicsError("MuJoCo warned of an invalid state")
         except control.PhysicsError:

@@ -72,11 +72,11 @@ class PlayroomTask(control.Task):
                 "a step"
             )
         self.step_index += 1
-        self.step_events = []
+        # This step's events start as the grasp's own list (a new one at every call).
         if self.movement == ARM:
-            self.step_events += self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
-        elif self.movement == VOICE:
-            self.step_events += self.grasp.during_voice(physics, self.step_index)
+            self.step_events = self.grasp.before_step(physics, action[:N_JOINTS], self.step_index)
+        else:
+            self.step_events = self.grasp.during_voice(physics, self.step_index)
             if self._planned_sound is not None:
                 self.sound = self._planned_sound[self.step_index - 1]
             else:

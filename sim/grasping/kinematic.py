@@ -53,6 +53,9 @@ class KinematicPhysics(PlayroomPhysics):
         out[0] = self.hand_position()
         return out
 
+    def write_tracked_positions(self, out: np.ndarray) -> None:
+        out[...] = self.tracked_positions()
+
     def stick_tip(self) -> np.ndarray:
         """The tip of the stick from its pose, by the same arithmetic as the held stick's."""
         x, y, yaw = self.object_poses()[0]

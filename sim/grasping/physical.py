@@ -36,6 +36,11 @@ class PhysicalGrasp(GraspBackend):
         return []
 
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        # A hand holding a toy, or the stick with a toy on its tip, takes nothing more in this
+        # movement: no contact to read.
+        tool_full = self.hand_holds != "stick" or self.stick_holds is not None
+        if self.hand_holds is not None and tool_full:
+            return []
         pairs = physics.touching_pairs()
         if len(pairs) == 0:
             return []
