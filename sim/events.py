@@ -49,9 +49,6 @@ def movement_events(
     positions: np.ndarray, step_events: list[Event], brought: str | None
 ) -> list[Event]:
     """Which objects moved, when first, and by what, from (51, 5, 2) positions (row 0 = start)."""
-    grasped = {e.obj for e in step_events if e.kind in (TOY_GRASPED, STICK_GRASPED)}
-    caught = {e.obj for e in step_events if e.kind == TOY_CAUGHT}
-    moved: list[Event] = []
     objects = positions[:, 1:]  # the hand is not an object that moves
     offsets = objects - objects[0]
     # np.linalg.norm(offsets, axis=2)'s arithmetic (x*x + y*y, then the root) without its
@@ -59,7 +56,13 @@ def movement_events(
     dx, dy = offsets[..., 0], offsets[..., 1]
     beyond = np.sqrt(dx * dx + dy * dy) > MOVED_DISTANCE  # (51, 4)
     # beyond.any(axis=0).nonzero(), without the wrappers of any() and np.flatnonzero.
-    for row in np.logical_or.reduce(beyond, axis=0).nonzero()[0]:
+    rows = np.logical_or.reduce(beyond, axis=0).nonzero()[0]
+    if rows.size == 0:  # most movements: nothing moved
+        return []
+    grasped = {e.obj for e in step_events if e.kind in (TOY_GRASPED, STICK_GRASPED)}
+    caught = {e.obj for e in step_events if e.kind == TOY_CAUGHT}
+    moved: list[Event] = []
+    for row in rows:
         name = TRACKED_OBJECTS[1 + row]
         step = int(beyond[:, row].argmax())
         if name == "stick":

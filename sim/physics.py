@@ -194,7 +194,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
     def set_object_poses(self, poses: np.ndarray) -> None:
         """Place the objects (4, 3) at rest and update the kinematics."""
         d = self._mj_data
-        d.qpos[self._object_qpos] = np.reshape(poses, -1)
+        d.qpos[self._object_qpos] = poses.reshape(-1)
         d.qvel[self._object_dof] = 0.0
         mujoco.mj_kinematics(self._mj_model, self._mj_data)
 

@@ -149,5 +149,5 @@ class Voice(abc.ABC):
         """The word the caregiver hears in a (10,) sound: the nearest word if within
         config.recognition_distance, else None."""
         dist = self.word_distances(features)
-        best = int(np.argmin(dist))
+        best = int(dist.argmin())
         return self.config.words[best] if dist[best] < self.config.recognition_distance else None
