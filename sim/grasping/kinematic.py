@@ -147,76 +147,58 @@ class KinematicGrasp(ClosedForm):
     def arm_movement(
         self, joint_targets: np.ndarray, stick_pose: np.ndarray, toys: np.ndarray
     ) -> ArmMovement:
+        # The compiled rules load numba: imported at the first movement, not with the package.
+        from sim.grasping import kinematic_kernel as kernel
+
         config = self.config
-        # sim/kinematics.hand_positions' arithmetic, with the cosines and sines kept: the held
-        # stick points along the last segment's angle, whose cosine and sine are among them.
+        # sim/kinematics.hand_positions' angles, cosines and sines; the rules themselves run
+        # compiled (sim/grasping/kinematic_kernel.py), with the same arithmetic.
         absolute = joint_targets.cumsum(axis=0) + config.arm_rest_offset  # (3, N_STEPS)
         cos, sin = np.cos(absolute), np.sin(absolute)
-        lengths = self._lengths
-        hand = np.empty((N_STEPS, 2))
-        # ndarray.sum's arithmetic (np.add.reduce), without its Python wrapper.
-        hand[:, 0] = np.add.reduce(lengths * cos, axis=0)
-        hand[:, 1] = np.add.reduce(lengths * sin, axis=0)
+        yaw = stick_pose[2]
+        lying_tip = stick_pose[:2] + config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])
         positions = np.empty((N_STEPS, 2 + len(TOYS), 2))
-        positions[:, 0] = hand
-        positions[:, 1] = stick_pose[:2]
-        positions[:, 2:] = toys
+        answers = np.empty(5, dtype=np.int64)
+        kernel.arm_movement_rules(
+            cos,
+            sin,
+            self._lengths,
+            stick_pose,
+            toys,
+            lying_tip,
+            config.catch_rule == "study",
+            self._distances,
+            positions,
+            answers,
+        )
+        k, first, on_stick, caught_step, caught_toy = answers.tolist()
         events: list[ev.Event] = []
-        free = np.ones(len(TOYS), dtype=bool)
-        on_stick = None  # the toy on the stick's tip
-        # Until the hand takes something nothing moves, so every distance is to a still object:
-        # (N_STEPS, stick and toys) at once.
-        offsets = positions[:, 1:] - hand[:, None, :]
-        near = np.hypot(offsets[..., 0], offsets[..., 1]) < config.grasp_distance
-        k, first = _first_near(near)  # 0-based step k: control step k + 1
-        if config.catch_rule == "study" and not (k == 0 and first == 0):
-            # The lying stick's tip catches a toy at the first step or never (nothing moves
-            # before the hand takes something), after the hand's pick of that step, if any.
-            if k == 0:
-                free[first - 1] = False
-            lying_tip = stick_pose[:2] + config.stick_length * np.array(
-                [np.cos(stick_pose[2]), np.sin(stick_pose[2])]
-            )
-            caught = (np.hypot(*(toys - lying_tip).T) < config.catch_distance) & free
-            if np.logical_or.reduce(caught):
-                on_stick = int(caught.argmax())
-                positions[:, 2 + on_stick] = lying_tip
-                free[on_stick] = False
-                events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
-                if k > 0:  # the hand's first grasp comes later: the caught toy is not free
-                    near[:, 1:] &= free
-                    k, first = _first_near(near)
+        if on_stick != kernel.NONE:
+            events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
         final_stick = np.array(stick_pose, dtype=float)
         if k == N_STEPS:
             return ArmMovement(positions, final_stick, events, None)
         if first > 0:
-            toy = first - 1
-            positions[k:, 2 + toy] = hand[k:]
-            events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=TOYS[toy], by="hand"))
-            return ArmMovement(positions, final_stick, _in_step_order(events), TOYS[toy])
+            toy = TOYS[first - 1]
+            events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=toy, by="hand"))
+            return ArmMovement(positions, final_stick, _in_step_order(events), toy)
         events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
-        positions[k:, 1] = hand[k:]
-        final_stick = np.array([*hand[-1], absolute[-1, -1]])
-        # The held stick points along the hand: its tip carries a toy caught before, or catches
-        # the first toy within reach.
-        tip = np.empty((N_STEPS - k, 2))
-        tip[:, 0] = hand[k:, 0] + config.stick_length * cos[-1, k:]
-        tip[:, 1] = hand[k:, 1] + config.stick_length * sin[-1, k:]
-        if on_stick is not None:
-            positions[k:, 2 + on_stick] = tip
-            return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
-        offsets = toys[None, :, :] - tip[:, None, :]
-        caught = (np.hypot(offsets[..., 0], offsets[..., 1]) < config.catch_distance) & free
-        c, toy = _first_near(caught)
-        if c < len(caught):
-            positions[k + c :, 2 + toy] = tip[c:]
-            events.append(ev.Event(ev.TOY_CAUGHT, k + c + 1, obj=TOYS[toy], by="stick"))
+        final_stick = np.array([*positions[-1, 0], absolute[-1, -1]])
+        if caught_toy != kernel.NONE:
+            obj = TOYS[caught_toy]
+            events.append(ev.Event(ev.TOY_CAUGHT, caught_step + 1, obj=obj, by="stick"))
         return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
 
     @functools.cached_property
     def _lengths(self) -> np.ndarray:
-        """(3, 1) the segment lengths, as sim/kinematics.hand_positions shapes them."""
-        return np.asarray(self.config.segment_lengths, dtype=float).reshape(3, 1)
+        """(3,) the segment lengths."""
+        return np.asarray(self.config.segment_lengths, dtype=float)
+
+    @functools.cached_property
+    def _distances(self) -> np.ndarray:
+        """(grasp, catch, stick length) for the kernel."""
+        cfg = self.config
+        return np.array([cfg.grasp_distance, cfg.catch_distance, cfg.stick_length])
 
     # Vocal movements: the resting hand's grab, stepped and in closed form -----------------
     def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
@@ -269,17 +251,6 @@ class KinematicGrasp(ClosedForm):
         """The handle lies beyond the arm's length plus the grasp distance."""
         cfg = self.config
         return float(np.hypot(*physics.stick_handle())) > cfg.arm_length + cfg.grasp_distance
-
-
-def _first_near(near: np.ndarray) -> tuple[int, int]:
-    """(first row with a True, first True column in it) of a (steps, objects) mask; (number of
-    rows, -1) when there is none. Columns are in priority order (the stick before the toys)."""
-    # np.flatnonzero(near.any(axis=1)), without the Python wrappers (twice per movement).
-    rows = np.logical_or.reduce(near, axis=1).nonzero()[0]
-    if rows.size == 0:
-        return len(near), -1
-    k = int(rows[0])
-    return k, int(near[k].argmax())
 
 
 def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:

@@ -53,3 +53,22 @@ def test_the_context_is_the_objects_positions_read_one_by_one() -> None:
             expected = [p.stick_handle(), p.toy_positions().ravel(), p.caregiver_position()]
             np.testing.assert_array_equal(room.context(), np.concatenate(expected))
             room.act_arm(m)
+
+
+def test_compiled_kernels_measure_distances_as_numpy_does() -> None:
+    """The compiled kinematic rules (sim/grasping/kinematic_kernel.py) take math.hypot for
+    NumPy's np.hypot: both must be the C library's, to the last bit, or a grasp at the
+    threshold could differ between the closed form and the step-by-step rules."""
+    import math
+
+    from sim.compiled import compiled
+
+    def hypots(dx: np.ndarray, dy: np.ndarray, out: np.ndarray) -> None:
+        for i in range(dx.size):
+            out[i] = math.hypot(dx[i], dy[i])
+
+    rng = np.random.default_rng(8)
+    dx, dy = rng.uniform(-2.0, 2.0, (2, 200000)) * rng.choice([1e-8, 1.0, 1e3], (2, 200000))
+    out = np.empty_like(dx)
+    compiled(hypots)(dx, dy, out)
+    np.testing.assert_array_equal(out, np.hypot(dx, dy))
