@@ -28,16 +28,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from learner.quantized_scan import (
-    BLOCK_ROWS,
-    CODE_MAX,
-    candidate_limit,
-    screen_candidates,
-)
+from learner.quantized_scan import BLOCK_ROWS, CODE_MAX, screen_query
 
 _INITIAL_CAPACITY = 1024
-# A query this far outside the grid (in steps) would overflow float32 sums: scanned exactly.
-_FAR_QUERY_CODES = 1e15
 
 
 def squared_distances(rows: np.ndarray, query: np.ndarray) -> np.ndarray:
@@ -163,22 +156,19 @@ class NearestNeighbourMemory:
         """(index of the nearest row, its squared distance, or None where a single candidate
         made computing it unnecessary) for a checked query."""
         n = self._n
-        q_codes = q * (CODE_MAX / self._scale)
-        if not np.maximum.reduce(np.abs(q_codes)) < _FAR_QUERY_CODES:
-            squared = squared_distances(self._rows[:n], q)
-            i = int(squared.argmin())  # as brute_force_nearest
-            return i, squared[i]
-        eta, rho = candidate_limit(self._dim, math.sqrt(q_codes @ q_codes))
-        count = screen_candidates(
+        count = screen_query(
             self._codes,
             n,
-            q_codes.astype(np.float32),
-            eta,
-            rho,
+            q,
+            CODE_MAX / self._scale,
             self._squared,
             self._block_min,
             self._candidates,
         )
+        if count < 0:  # far outside the grid: scanned exactly
+            squared = squared_distances(self._rows[:n], q)
+            i = int(squared.argmin())  # as brute_force_nearest
+            return i, squared[i]
         if count == 1:
             return int(self._candidates[0]), None
         # In increasing index order, so argmin's first minimum is the lowest index of a tie.

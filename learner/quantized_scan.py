@@ -27,6 +27,10 @@ _F32_UNIT_ROUNDOFF = 2.0**-24
 CODE_MAX = 127  # codes are int8 in [-127, 127]
 
 
+# A query this far outside the grid (in steps) would overflow float32 sums: scanned exactly.
+FAR_QUERY_CODES = 1e15
+
+
 def candidate_limit(dim: int, query_code_norm: float) -> tuple[float, float]:
     """(eta, rho) of the screening bound, in code units (distances divided by the step).
 
@@ -53,6 +57,9 @@ def _compiled(function):
         return numba.njit(cache=True, **options)(function)
     except RuntimeError:
         return numba.njit(**options)(function)
+
+
+_candidate_limit = _compiled(candidate_limit)  # the same bound, callable from the kernels
 
 
 @_compiled
@@ -118,11 +125,37 @@ def screen_candidates(
     return count
 
 
+@_compiled
+def screen_query(
+    codes: np.ndarray,
+    n: int,
+    q: np.ndarray,
+    code_scale: float,
+    squared: np.ndarray,
+    block_min: np.ndarray,
+    candidates: np.ndarray,
+) -> int:  # pragma: no cover - compiled; its answers are tested against brute force
+    """`screen_candidates` for a float64 query q (dim,) in the rows' units: its codes (q times
+    code_scale, rounded to float32) and the bound made here rather than in NumPy calls around
+    the kernel. Returns the candidates' count, or -1 for a query too far outside the grid for
+    float32 sums (FAR_QUERY_CODES), which the caller scans exactly."""
+    dim = q.shape[0]
+    query = np.empty(dim, np.float32)
+    largest, norm2 = 0.0, 0.0
+    for d in range(dim):
+        v = q[d] * code_scale
+        largest = max(largest, abs(v))
+        norm2 += v * v
+        query[d] = np.float32(v)
+    if not largest < FAR_QUERY_CODES:
+        return -1
+    eta, rho = _candidate_limit(dim, math.sqrt(norm2))
+    return screen_candidates(codes, n, query, eta, rho, squared, block_min, candidates)
+
+
 def warm_up() -> None:
     """Load (or, on a first run, compile and cache) the kernel now rather than at the first
     query: once per process, 0.2 s from numba's cache, about 1 s to compile."""
     codes = np.zeros((1, 1), dtype=np.int8)
     scratch = np.empty(1, dtype=np.float32)
-    screen_candidates(
-        codes, 1, scratch, 0.0, 0.0, scratch.copy(), scratch.copy(), np.empty(1, np.intp)
-    )
+    screen_query(codes, 1, np.zeros(1), 1.0, scratch, scratch.copy(), np.empty(1, np.intp))

@@ -48,10 +48,9 @@ class FormantMap:
         h = np.asarray(artic, dtype=float)
         for w, b in zip(self.weights[:-1], self.biases[:-1], strict=True):
             z = h @ w
-            z += b
             h = np.zeros(z.shape)
-            h[rows] = np.tanh(z[rows])
-        return ((h @ self.weights[-1] + self.biases[-1]) * self.y_std + self.y_mean)[rows]
+            h[rows] = np.tanh(z[rows] + b)  # the bias too only where it is needed
+        return ((h @ self.weights[-1])[rows] + self.biases[-1]) * self.y_std + self.y_mean
 
     def save(self, path: Path = DATA_FILE, **report: np.ndarray | float) -> None:
         """Write the weights, plus any fit report values (stored for the record)."""

@@ -114,14 +114,14 @@ def test_memory_rejects_bad_input() -> None:
 def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
     """`playroom bench` times the kernel's load apart from the trials: that holds only if the
     warm-up compiles the very specialisation a memory's query calls."""
-    from learner.quantized_scan import screen_candidates, warm_up
+    from learner.quantized_scan import screen_query, warm_up
 
     warm_up()
-    loaded = set(screen_candidates.signatures)
+    loaded = set(screen_query.signatures)
     memory = NearestNeighbourMemory(14)
     memory.extend(np.random.default_rng(5).uniform(-1, 1, (100, 14)))
     memory.nearest(np.zeros(14))
-    assert set(screen_candidates.signatures) == loaded
+    assert set(screen_query.signatures) == loaded
 
 
 def test_memory_works_where_numba_cannot_cache(tmp_path) -> None:
