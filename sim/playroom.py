@@ -138,7 +138,8 @@ class Playroom:
         if closed is not None and at_samples is not None:
             # What the learner and the caregiver hear are the 5 sample steps: only those are
             # computed now, the other steps when the feedback's `sound` is read.
-            formants = np.full((N_STEPS, 2), np.nan)
+            formants = np.empty((N_STEPS, 2))
+            formants.fill(np.nan)  # np.full's array, without its Python wrapper
             formants[SAMPLE_STEPS] = at_samples
             whole = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))  # noqa: E731
             feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
@@ -244,6 +245,7 @@ class Playroom:
         poses = p.object_poses()
         sound = np.zeros((N_STEPS, 2))
         held = None
+        still = False  # a vocal movement in which nothing moves: no movement to detect
         if movement == ARM:
             assert joint_targets is not None  # act_arm passes them
             outcome = closed.arm_movement(joint_targets, poses[0], poses[1:, :2])
@@ -257,6 +259,8 @@ class Playroom:
                 events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
                 positions[1:, 1] = positions[0, 0]
                 poses[0] = (*positions[0, 0], self.config.arm_rest_offset)
+            else:
+                still = self.caregiver.bringing is None
             sound[:] = self.task.normalised(voice_formants)
             toy = self.caregiver.bringing
             if toy is not None:
@@ -264,7 +268,9 @@ class Playroom:
                 positions[1:, 2 + toy] = path
         poses[1:, :2] = positions[-1, 2:]
         brought = self.caregiver.bringing
-        events += ev.movement_events(positions, events, None if brought is None else TOYS[brought])
+        if not still:  # (movement_events finds nothing in still positions)
+            brought_name = None if brought is None else TOYS[brought]
+            events += ev.movement_events(positions, events, brought_name)
         said = self.caregiver.speak(held, self.rng) if movement == ARM else None
         p.set_object_poses(poses)
         self.caregiver.stop(p)

@@ -57,6 +57,7 @@ from experiments.run.trial_files import (
 from models.layout import TOYS, block_slice
 
 _SOUND = block_slice("sound")
+_TOY_MOVED_BY = tuple(f"{toy}_moved_by" for toy in TOYS)
 
 
 class Trial:
@@ -277,7 +278,7 @@ class Trial:
             distances = self.room.vocal_tract.word_distances(sound)
             np.minimum(self.best_word_distance, distances, out=self.best_word_distance)
         row = log_row(self.iteration, proposal, feedback, context)
-        self.counts["tool_uses"] += sum(row[f"{toy}_moved_by"] == "stick" for toy in TOYS)
+        self.counts["tool_uses"] += sum(row[column] == "stick" for column in _TOY_MOVED_BY)
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
         self.counts["stick_returns"] += row["stick_returned"]
