@@ -28,7 +28,13 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.batches import scheduler as dask_scheduler
-from experiments.batches.progress import REPORT_EVERY, BatchProgress, dashboard_link, reporter
+from experiments.batches.progress import (
+    REPORT_EVERY,
+    REPORT_INTERVAL_S,
+    BatchProgress,
+    dashboard_link,
+    reporter,
+)
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.file_names import (
     BATCH_FILE,
@@ -76,10 +82,12 @@ def run_and_evaluate(
     topic: str | None = None,
     progress_topic: str | None = None,
     report_every: int = REPORT_EVERY,
+    report_interval_s: float = REPORT_INTERVAL_S,
 ) -> dict:
     """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
     for another writer of the trial is told to the client listening on `topic`, the iteration
-    the trial reached (every `report_every`) to the one listening on `progress_topic`."""
+    the trial reached (looked at every `report_every`, told at most every
+    `report_interval_s`) to the one listening on `progress_topic`."""
     path = Path(trial_dir)
     # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
     # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
@@ -102,7 +110,8 @@ def run_and_evaluate(
         start = time.perf_counter()
         trial = run_trial(
             path, settings, resume=resume, progress=False,
-            report=reporter(progress_topic, path.name), report_every=report_every,
+            report=reporter(progress_topic, path.name, report_interval_s),
+            report_every=report_every,
         )  # fmt: skip
         if trial.elapsed is not None:
             # Only the iterations run now are timed, so resumed trials still give a fair cost.
@@ -138,13 +147,15 @@ def run_batch(
     progress: bool = True,
     notify: Callable[[str], None] | None = None,
     report_every: int = REPORT_EVERY,
+    report_interval_s: float = REPORT_INTERVAL_S,
 ) -> dict[str, dict]:
     """Run every trial of `spec` under out_dir (skipping completed ones); returns the
     evaluation summary of each trial run now, by name. Trials that fail are reported and the
     others go on; BatchError at the end names the failures, or at once says the scheduler is
     not one or was lost. The Dask dashboard's link is printed on stderr first; `notify` gets
     the lines said while trials run (default: stderr); `progress`: a bar of the iterations
-    done across the trials, moved every `report_every` iterations of each
+    done across the trials, moved at most every `report_interval_s` by each trial (looked at
+    every `report_every` iterations)
     (experiments/batches/progress.py)."""
     from distributed import as_completed
 
@@ -194,7 +205,8 @@ def run_batch(
             key = task_key(name, trial_dir, settings, spec.eval_placements, run)
             future = client.submit(
                 run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
-                progress_topic, report_every, key=key, pure=False, retries=2,
+                progress_topic, report_every, report_interval_s, key=key, pure=False,
+                retries=2,
             )  # fmt: skip
             futures[future] = name
         if skipped and progress:

@@ -63,7 +63,12 @@ def test_a_batch_prints_the_link_and_advances_within_each_trial(
     monkeypatch.setattr(progress_module.BatchProgress, "reached", recording)
     # Through the scheduler's address, as `--scheduler tcp://...` connects.
     results = run_batch(
-        TINY, tmp_path, scheduler=own.scheduler_address, progress=True, report_every=5
+        TINY,
+        tmp_path,
+        scheduler=own.scheduler_address,
+        progress=True,
+        report_every=5,
+        report_interval_s=0.0,
     )
     assert sorted(results) == [name for name, _ in TINY.trials()]
     err = capsys.readouterr().err
@@ -104,3 +109,35 @@ def test_the_largest_recorded_size_applies_and_none_without_a_record(tmp_path):
     assert recorded_reference_commands([small]) == 300
     assert recorded_reference_commands([small, large, old]) == 30000
     assert recorded_reference_commands([old]) is None
+
+
+def test_a_local_cluster_s_workers_wake_seldom(cluster):
+    """Dask's default 20 ms ticks and 10 ms stack samples slowed trials by a tenth."""
+    import dask
+
+    client, _ = cluster
+    keys = sorted(dask_scheduler.LOCAL_WORKER_CONFIG)
+    seen = client.run(lambda: [dask.config.get(key) for key in keys])
+    for values in seen.values():
+        assert values == [dask_scheduler.LOCAL_WORKER_CONFIG[key] for key in keys]
+
+
+def test_a_trial_reports_its_start_then_at_most_once_a_while(monkeypatch):
+    import distributed
+
+    sent: list[dict] = []
+
+    class Worker:
+        def log_event(self, topic: str, message: dict) -> None:
+            sent.append(message)
+
+    monkeypatch.setattr(distributed, "get_worker", Worker)
+    seldom = progress_module.reporter("topic", "trial", min_interval_s=3600.0)
+    assert seldom is not None
+    for iteration in (0, 100, 200):
+        seldom(iteration)
+    assert sent == [{"trial": "trial", "iteration": 0}]
+    every_time = progress_module.reporter("topic", "trial", min_interval_s=0.0)
+    assert every_time is not None
+    every_time(300)
+    assert sent[-1] == {"trial": "trial", "iteration": 300}
