@@ -1,12 +1,13 @@
 """The study's kinematic rules (docs/protocol.md §5, §6; the catch rule departs, §11), each
-written twice side by side: stepped, as the dm_control task applies it one control step at a
-time (the room's path when step observers watch, as in videos), and in closed form over a whole
-movement at once (the room's fast path). The arm follows its targets exactly and objects move
-only when held or carried, so a movement is geometry: the hand's path is the forward kinematics
-of the 50 targets in one array operation, a rule fires at the first step at which a distance
-drops below its threshold, and held objects follow the hand (or the held stick's tip) from that
-step on. tests/world/test_kinematic_paths.py compares the two forms on thousands of commands, sample
-by sample and event by event: change a rule in both forms here, and run it.
+written twice: stepped, as the dm_control task applies it one control step at a time (the
+room's path when step observers watch, as in videos), and in closed form over a whole movement
+at once (the room's fast path; the arm's rules compiled in kinematic_kernel.py). The arm
+follows its targets exactly and objects move only when held or carried, so a movement is
+geometry: the hand's path is the forward kinematics of the 50 targets, a rule fires at the
+first step at which a distance drops below its threshold, and held objects follow the hand (or
+the held stick's tip) from that step on. tests/world/test_kinematic_paths.py compares the two
+forms on thousands of commands, sample by sample and event by event: change a rule in both
+forms, and run it.
 """
 
 from __future__ import annotations
