@@ -36,7 +36,7 @@ def weighted_choice(rng: np.random.Generator, p: np.ndarray) -> int:
     of p (a third of a choice's cost, every iteration). p (n,) non-negative, summing to 1.
 
     Generator.choice's own arithmetic: the normalised cumulative sum, searched for one uniform
-    draw. tests/learner/test_interest.py holds it to Generator.choice draw by draw.
+    draw. tests/agent/test_same_draws.py holds it to Generator.choice draw by draw.
     """
     cdf = p.cumsum()
     cdf /= cdf[-1]

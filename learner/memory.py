@@ -132,10 +132,10 @@ class NearestNeighbourMemory:
         query (dim,). Raises ValueError if the memory is empty or the query is malformed.
         """
         q = self._checked_query(query)
-        best, squared = self._search(q)
-        if squared is None:
-            squared = squared_distances(self._rows[best : best + 1], q)[0]
-        return best, float(np.sqrt(squared))
+        best, distance = self._search(q)
+        if distance is None:
+            distance = float(np.sqrt(squared_distances(self._rows[best : best + 1], q)[0]))
+        return best, distance
 
     def nearest_index(self, query: ArrayLike) -> int:
         """The index `nearest` answers, without computing its distance (the learner's inverse
@@ -152,9 +152,9 @@ class NearestNeighbourMemory:
             raise ValueError("nearest neighbour asked of an empty memory")
         return q
 
-    def _search(self, q: np.ndarray) -> tuple[int, np.float64 | None]:
-        """(index of the nearest row, its squared distance, or None where a single candidate
-        made computing it unnecessary) for a checked query."""
+    def _search(self, q: np.ndarray) -> tuple[int, float | None]:
+        """(index of the nearest row, its distance, or None where a single candidate made
+        computing it unnecessary) for a checked query."""
         n = self._n
         count = screen_query(
             self._codes,
@@ -166,16 +166,14 @@ class NearestNeighbourMemory:
             self._candidates,
         )
         if count < 0:  # far outside the grid: scanned exactly
-            squared = squared_distances(self._rows[:n], q)
-            i = int(squared.argmin())  # as brute_force_nearest
-            return i, squared[i]
+            return brute_force_nearest(self._rows[:n], q)
         if count == 1:
             return int(self._candidates[0]), None
         # In increasing index order, so argmin's first minimum is the lowest index of a tie.
         candidates = self._candidates[:count]
         squared = squared_distances(self._rows[candidates], q)
         j = int(squared.argmin())
-        return int(candidates[j]), squared[j]
+        return int(candidates[j]), float(np.sqrt(squared[j]))
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """{'rows': (n, dim) float64 copy}: plain arrays for np.savez."""

@@ -31,6 +31,19 @@ CODE_MAX = 127  # codes are int8 in [-127, 127]
 FAR_QUERY_CODES = 1e15
 
 
+def _compiled(function):
+    """`function` compiled by numba, cached on disk beside the package (or in the user's
+    cache) so that later processes load it in 0.2 s. Where no cache directory is writable (a
+    read-only install without a home directory) numba refuses to cache: it is then compiled
+    once per process instead, about 1 s."""
+    options: dict[str, Any] = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
+    try:
+        return numba.njit(cache=True, **options)(function)
+    except RuntimeError:
+        return numba.njit(**options)(function)
+
+
+@_compiled  # called by the kernel below (and callable from Python)
 def candidate_limit(dim: int, query_code_norm: float) -> tuple[float, float]:
     """(eta, rho) of the screening bound, in code units (distances divided by the step).
 
@@ -45,21 +58,6 @@ def candidate_limit(dim: int, query_code_norm: float) -> tuple[float, float]:
     eta = 0.5 * math.sqrt(dim) * (1.0 + 1e-9) + 2.0 * _F32_UNIT_ROUNDOFF * query_code_norm
     rho = 2.0 * (dim + 3) * _F32_UNIT_ROUNDOFF
     return eta, rho
-
-
-def _compiled(function):
-    """`function` compiled by numba, cached on disk beside the package (or in the user's
-    cache) so that later processes load it in 0.2 s. Where no cache directory is writable (a
-    read-only install without a home directory) numba refuses to cache: it is then compiled
-    once per process instead, about 1 s."""
-    options: dict[str, Any] = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
-    try:
-        return numba.njit(cache=True, **options)(function)
-    except RuntimeError:
-        return numba.njit(**options)(function)
-
-
-_candidate_limit = _compiled(candidate_limit)  # the same bound, callable from the kernels
 
 
 @_compiled
@@ -149,7 +147,7 @@ def screen_query(
         query[d] = np.float32(v)
     if not largest < FAR_QUERY_CODES:
         return -1
-    eta, rho = _candidate_limit(dim, math.sqrt(norm2))
+    eta, rho = candidate_limit(dim, math.sqrt(norm2))
     return screen_candidates(codes, n, query, eta, rho, squared, block_min, candidates)
 
 

@@ -74,3 +74,30 @@ def batches(tmp_path_factory):
             evaluate_trial(trial, EvaluationSettings(n_placements=3))
         out[grasp] = batch
     return out
+
+
+@pytest.fixture
+def run_without_numba_cache(tmp_path):
+    """Run Python code in a process where numba finds no cache directory, as in a read-only
+    install without a writable home (its only allowed one is a path under a file): returns
+    what the code printed; asserts it ran and that no cache was made."""
+    import subprocess
+    import sys
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    env = dict(
+        os.environ,
+        NUMBA_CACHE_LOCATOR_CLASSES="UserProvidedCacheLocator",
+        NUMBA_CACHE_DIR=str(blocker / "cache"),
+    )
+
+    def run(code: str) -> str:
+        result = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env
+        )
+        assert result.returncode == 0, result.stderr
+        assert not (blocker.parent / "cache").exists()
+        return result.stdout.strip()
+
+    return run

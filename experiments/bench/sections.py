@@ -209,8 +209,10 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
     )
     yield "evaluation_of_that_trial", evaluation_s, "s"
     # make replicate runs two trials at once on 2 cores, which share the machine's caches and
-    # memory: each then ran 1.2-1.5 times slower than alone. Measured so, side by side.
-    pair = replication_pair_seconds(replication.trials()[:2], replication.eval_placements)
+    # memory bandwidth: measured so, side by side.
+    pair = replication_pair_seconds(
+        [s for _, s in replication.trials()[:2]], replication.eval_placements
+    )
     yield (
         f"kinematic_trial_{settings.iterations}_beside_another",
         float(np.mean([t for t, _ in pair])),

@@ -37,11 +37,10 @@ def replication_trial_seconds(settings: TrialSettings, placements: int) -> tuple
 
 
 def replication_pair_seconds(
-    trials: list[tuple[str, TrialSettings]], placements: int
+    settings: list[TrialSettings], placements: int
 ) -> list[tuple[float, float]]:
-    """`replication_trial_seconds` of two trials run at once, each in its own process (as two
+    """`replication_trial_seconds` of trials run at once, each in its own process (as two
     batch workers run them), after each process has loaded the memory's kernel."""
-    settings = [s for _, s in trials]
     # Fresh interpreters ("spawn"), as Dask's workers are: no state inherited from this one.
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(len(settings), mp_context=context) as pool:

@@ -156,8 +156,11 @@ class KinematicGrasp(ClosedForm):
         # compiled (sim/grasping/kinematic_kernel.py), with the same arithmetic.
         absolute = joint_targets.cumsum(axis=0) + config.arm_rest_offset  # (3, N_STEPS)
         cos, sin = np.cos(absolute), np.sin(absolute)
-        yaw = stick_pose[2]
-        lying_tip = stick_pose[:2] + config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])
+        study_catch = config.catch_rule == "study"
+        lying_tip = stick_pose[:2]  # read by the kernel only under the study's catch rule
+        if study_catch:
+            yaw = stick_pose[2]
+            lying_tip = lying_tip + config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])
         positions = np.empty((N_STEPS, 2 + len(TOYS), 2))
         answers = np.empty(5, dtype=np.int64)
         kernel.arm_movement_rules(
@@ -167,7 +170,7 @@ class KinematicGrasp(ClosedForm):
             stick_pose,
             toys,
             lying_tip,
-            config.catch_rule == "study",
+            study_catch,
             self._distances,
             positions,
             answers,

@@ -124,20 +124,9 @@ def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
     assert set(screen_query.signatures) == loaded
 
 
-def test_memory_works_where_numba_cannot_cache(tmp_path) -> None:
-    """A read-only install without a writable home: numba finds no cache directory (here: its
-    only allowed one is a path under a file) and the kernel is compiled in the process."""
-    import os
-    import subprocess
-    import sys
-
-    blocker = tmp_path / "a-file"
-    blocker.write_text("")
-    env = dict(
-        os.environ,
-        NUMBA_CACHE_LOCATOR_CLASSES="UserProvidedCacheLocator",
-        NUMBA_CACHE_DIR=str(blocker / "cache"),
-    )
+def test_memory_works_where_numba_cannot_cache(run_without_numba_cache) -> None:
+    """A read-only install without a writable home: numba finds no cache directory and the
+    kernel is compiled in the process."""
     code = (
         "import numpy as np\n"
         "from learner.memory import NearestNeighbourMemory, brute_force_nearest\n"
@@ -148,7 +137,4 @@ def test_memory_works_where_numba_cannot_cache(tmp_path) -> None:
         "assert memory.nearest(q) == brute_force_nearest(rows, q)\n"
         "print('exact')\n"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "exact"
-    assert not (blocker.parent / "cache").exists()
+    assert run_without_numba_cache(code) == "exact"

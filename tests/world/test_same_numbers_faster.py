@@ -74,20 +74,9 @@ def test_compiled_kernels_measure_distances_as_numpy_does() -> None:
     np.testing.assert_array_equal(out, np.hypot(dx, dy))
 
 
-def test_the_compiled_rules_work_where_numba_cannot_cache(tmp_path) -> None:
+def test_the_compiled_rules_work_where_numba_cannot_cache(run_without_numba_cache) -> None:
     """A read-only install without a writable home: the kinematic rules are compiled in the
     process (no cache directory numba may use) and move the room as the cached ones do."""
-    import os
-    import subprocess
-    import sys
-
-    blocker = tmp_path / "a-file"
-    blocker.write_text("")
-    env = dict(
-        os.environ,
-        NUMBA_CACHE_LOCATOR_CLASSES="UserProvidedCacheLocator",
-        NUMBA_CACHE_DIR=str(blocker / "cache"),
-    )
     code = (
         "import numpy as np\n"
         "from sim import Playroom\n"
@@ -95,10 +84,8 @@ def test_the_compiled_rules_work_where_numba_cannot_cache(tmp_path) -> None:
         "commands = np.random.default_rng(9).uniform(-1.0, 1.0, (40, 21))\n"
         "print(np.concatenate([room.act_arm(m).s for m in commands]).tobytes().hex())\n"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-    assert result.returncode == 0, result.stderr
+    printed = run_without_numba_cache(code)
     room = Playroom("kinematic", seed=3)
     commands = np.random.default_rng(9).uniform(-1.0, 1.0, (40, 21))
     here = np.concatenate([room.act_arm(m).s for m in commands]).tobytes().hex()
-    assert result.stdout.strip() == here
-    assert not (blocker.parent / "cache").exists()
+    assert printed == here
