@@ -17,6 +17,13 @@ OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y
 # Physics steps per control step: the model's 2 ms timestep makes a 20 ms control step, so a
 # 50-step movement lasts 1 s.
 CONTROL_SUBSTEPS = 10
+# The contact sensors of models/playroom.xml the physical grasp acts on, in this order: the
+# hand on the stick's handle, the hand on each toy, the stick's tip on each toy.
+GRASP_CONTACTS = (
+    "hand_stick",
+    *(f"hand_{toy}" for toy in TOYS),
+    *(f"stick_{toy}" for toy in TOYS),
+)
 
 
 class PlayroomPhysics(dm_mujoco.Physics):
@@ -112,6 +119,15 @@ class PlayroomPhysics(dm_mujoco.Physics):
             [[m.jnt_dofadr[joint(f"{o}_{a}")] for a in ("x", "y", "yaw")] for o in OBJECTS]
         )
         self.home_key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "home")
+        sensor = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, n)  # noqa: E731
+        missing = [n for n in GRASP_CONTACTS if sensor(n) < 0]
+        if missing:
+            raise ValueError(
+                f"the MJCF model has no contact sensor named {', '.join(missing)}: the physical "
+                "grasp reads them (see the <sensor> section of models/playroom.xml)"
+            )
+        # sensordata addresses of GRASP_CONTACTS (each sensor one number).
+        self.grasp_contact_adr = np.array([m.sensor_adr[sensor(n)] for n in GRASP_CONTACTS])
         # Flat views of the position arrays and the flat indices of the tracked x, y values:
         # one `take` each reads them (read every control step; fancy indexing of the 2-D
         # arrays cost several times more). The views live as long as this data.
@@ -129,6 +145,9 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._object_qpos = _as_slice(self.object_qpos)
         self._object_dof = _as_slice(self.object_dof)
         self._object_shape = self.object_qpos.shape
+        # What the compiled control steps read and write (sim/compiled_steps.py).
+        self._tracked_sites = np.array([self.hand_site, self.handle_site])
+        self._caregiver_hand_row = d.mocap_pos[self.caregiver_hand_mocap]
 
     def _reload_from_data(self, data) -> None:
         super()._reload_from_data(data)
@@ -209,9 +228,54 @@ class PlayroomPhysics(dm_mujoco.Physics):
             mujoco.mj_step(m, d, nstep - 1)
         mujoco.mj_step1(m, d)
 
+    def control_steps(
+        self,
+        start: int,
+        arm_targets: np.ndarray,
+        bring_to: np.ndarray | None,
+        bring_rate: float,
+        positions: np.ndarray,
+        watched: np.ndarray,
+    ) -> int:
+        """Control steps `start`, `start` + 1, ... of a movement in compiled code, each
+        CONTROL_SUBSTEPS physics steps taken as `advance` takes them: before each, the servos'
+        targets arm_targets[k] (n, 3) (or, if empty, left as they are) and the caregiver's hand
+        `bring_rate` of the way to bring_to (2,) (or None: not moved); after each, the tracked
+        positions in positions[k + 1] (n + 1, 5, 2). Returns the first step after which a
+        sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. Only where
+        sim.compiled_steps.AVAILABLE."""
+        from sim.compiled_steps import control_steps
+
+        if not positions.flags.c_contiguous:  # its rows are written through a flat view
+            raise ValueError("positions must be a C-contiguous (n + 1, 5, 2) array")
+        d = self._mj_data
+        return control_steps(
+            self._mj_model._address,
+            d._address,
+            CONTROL_SUBSTEPS,
+            start,
+            arm_targets,
+            d.ctrl,
+            np.empty(0) if bring_to is None else bring_to,
+            bring_rate,
+            self._caregiver_hand_row,
+            d.site_xpos,
+            d.xpos,
+            self._tracked_sites,
+            self.toy_bodies,
+            positions.reshape(len(positions), -1),
+            d.sensordata,
+            self.grasp_contact_adr[watched],
+        )
+
     def warning_counts(self) -> np.ndarray:
         """(mjNWARNING,) how often MuJoCo has warned of each kind (a diverging state warns)."""
         return self._mj_data.warning.number.copy()
+
+    def grasp_contacts(self) -> np.ndarray:
+        """(7,) how many contacts MuJoCo found between each pair of GRASP_CONTACTS, current
+        after every step as the contact list is."""
+        return self._mj_data.sensordata.take(self.grasp_contact_adr)
 
     def touching_pairs(self) -> np.ndarray:
         """(n, 2) geom ids of the pairs MuJoCo reports in contact now."""

@@ -295,21 +295,16 @@ class Playroom:
         warnings = p.warning_counts()
         task = self.task
         try:
-            for k in range(n):
-                if self.step_observers:  # through the dm_control environment, observed
+            if self.step_observers:  # through the dm_control environment, observed
+                for k in range(n):
                     obs = self.env.step(actions[k]).observation
                     positions[k + 1] = (obs["hand"], obs["stick_handle"], *obs["toys"])
                     sound[k] = obs["sound"]
                     for observer in self.step_observers:
                         observer(k + 1, obs)
-                else:  # the same step, reading only what the feedback needs
-                    task.before_step(actions[k], p)
-                    p.advance(CONTROL_SUBSTEPS)
-                    task.after_step(p)
-                    p.write_tracked_positions(positions[k + 1])
-                    sound[k] = task.sound
-                if task.step_events:
                     events += task.step_events
+            else:  # the same steps, reading only what the feedback needs
+                events += task.run_steps(p, actions, positions, sound)
             if (p.warning_counts() > warnings).any() or not np.isfinite(positions).all():
                 raise control.PhysicsError("MuJoCo warned of an invalid state")
         except control.PhysicsError:

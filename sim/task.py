@@ -14,6 +14,7 @@ act in: environments that act, one command a step, are in sim/envs/.
 from __future__ import annotations
 
 import collections
+from collections.abc import Callable
 
 import numpy as np
 from dm_env import specs
@@ -23,7 +24,7 @@ from sim import events as ev
 from sim.caregiver import Caregiver
 from sim.dm_control_import import control
 from sim.grasping.base import GraspBackend
-from sim.physics import PlayroomPhysics
+from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 from sim.vocal.voice import Voice
 
 ARM = "arm"
@@ -49,6 +50,8 @@ class PlayroomTask(control.Task):
         self.sound = np.zeros(2)
         self._planned_sound: np.ndarray | None = None
         self.step_events: list[ev.Event] = []
+        # Whether unobserved movements may run in compiled code (run_steps).
+        self.compiled_steps = True
 
     # dm_control interface -----------------------------------------------------------------
     def initialize_episode(self, physics: PlayroomPhysics) -> None:
@@ -86,6 +89,66 @@ class PlayroomTask(control.Task):
     def after_step(self, physics: PlayroomPhysics) -> None:
         if self.movement == ARM:
             self.step_events += self.grasp.after_step(physics, self.step_index)
+
+    # A movement's steps, unobserved --------------------------------------------------------
+    def run_steps(
+        self,
+        physics: PlayroomPhysics,
+        actions: np.ndarray,
+        positions: np.ndarray,
+        sound: np.ndarray,
+    ) -> list[ev.Event]:
+        """Every control step of the movement begun, as the dm_control environment takes them
+        but without observations: after step k the tracked positions in positions[k + 1]
+        (n + 1, 5, 2) and the sound sensor in sound[k] (n, 2). Returns the steps' events.
+
+        A backend with compiled stepping (the physical one) runs the steps in compiled code
+        between the contacts it acts on, where MuJoCo's library is found and `compiled_steps`
+        is True (the default); otherwise each step runs here in Python, the reference the
+        compiled loop is tested against (tests/world/test_compiled_steps.py).
+        """
+        from sim.compiled_steps import AVAILABLE
+
+        stepper = getattr(self.grasp, "run_steps", None)
+        sound_known = self.movement == ARM or self._planned_sound is not None
+        if self.compiled_steps and AVAILABLE and stepper is not None and sound_known:
+            return self._run_compiled(stepper, physics, actions, positions, sound)
+        events: list[ev.Event] = []
+        for k in range(len(actions)):
+            self.before_step(actions[k], physics)
+            physics.advance(CONTROL_SUBSTEPS)
+            self.after_step(physics)
+            physics.write_tracked_positions(positions[k + 1])
+            sound[k] = self.sound
+            events += self.step_events
+        return events
+
+    def _run_compiled(
+        self,
+        stepper: Callable[..., int],
+        physics: PlayroomPhysics,
+        actions: np.ndarray,
+        positions: np.ndarray,
+        sound: np.ndarray,
+    ) -> list[ev.Event]:
+        n = len(actions)
+        grasping = self.movement == ARM
+        if grasping:
+            targets = np.ascontiguousarray(actions[:, :N_JOINTS])
+        else:  # the arm rests; the sound is the planned one, step by step
+            targets = np.empty((0, N_JOINTS))
+            sound[:] = self._planned_sound
+            self.sound[:] = sound[n - 1]
+        bring_to = None if self.caregiver.bringing is None else self.caregiver.target(physics)
+        events: list[ev.Event] = []
+        k = stepper(physics, targets, bring_to, 0, positions, grasping)
+        while k < n:  # a contact the grasp acts on, after step k
+            self.step_index = k + 1
+            events += self.grasp.after_step(physics, self.step_index)
+            physics.write_tracked_positions(positions[k + 1])  # as the grasp left them
+            k = stepper(physics, targets, bring_to, k + 1, positions, grasping)
+        self.step_index = n
+        return events
 
     def get_observation(self, physics: PlayroomPhysics) -> collections.OrderedDict:
         obs = collections.OrderedDict()

@@ -19,6 +19,10 @@ from sim.physics import OBJECTS, PlayroomPhysics
 # The name under which the caregiver's carrying edits the model (sim/model_edits.py); the
 # grasps edit it under the backend's name.
 CAREGIVER = "caregiver"
+# Where GRASP_CONTACTS (sim/physics.py) holds each kind of contact.
+HAND_ON_HANDLE = 0
+HAND_ON_TOYS = slice(1, 1 + len(TOYS))
+TIP_ON_TOYS = slice(1 + len(TOYS), 1 + 2 * len(TOYS))
 
 
 class PhysicalGrasp(GraspBackend):
@@ -35,21 +39,47 @@ class PhysicalGrasp(GraspBackend):
         physics.data.ptr.ctrl[:] = joint_targets
         return []
 
+    def run_steps(
+        self,
+        physics: PlayroomPhysics,
+        arm_targets: np.ndarray,
+        bring_to: np.ndarray | None,
+        start: int,
+        positions: np.ndarray,
+        grasping: bool,
+    ) -> int:
+        """Control steps from `start` in compiled code (PlayroomPhysics.control_steps), as
+        `before_step` and the caregiver's carrying would take them; while `grasping` (an arm
+        movement), until a contact that would take something appears: returns that step,
+        whose `after_step` the caller then takes, or n."""
+        watched = self.watched_contacts() if grasping else np.empty(0, dtype=int)
+        return physics.control_steps(
+            start, arm_targets, bring_to, self.config.caregiver_bring_rate, positions, watched
+        )
+
+    def watched_contacts(self) -> np.ndarray:
+        """Indices into GRASP_CONTACTS (sim/physics.py) of the contacts that would take
+        something now: with the hand empty, the hand on the handle or on a free toy; with the
+        stick in the hand and nothing on its tip, the tip on a free toy; otherwise none."""
+        free = self._free_toy_mask()
+        if self.hand_holds is None:
+            return np.flatnonzero(np.concatenate(([True], free, [False] * len(TOYS))))
+        if self.hand_holds == "stick" and self.stick_holds is None:
+            return TIP_ON_TOYS.start + np.flatnonzero(free)
+        return np.empty(0, dtype=int)
+
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
-        # A hand holding a toy, or the stick with a toy on its tip, takes nothing more in this
-        # movement: no contact to read.
-        tool_full = self.hand_holds != "stick" or self.stick_holds is not None
-        if self.hand_holds is not None and tool_full:
+        watched = self.watched_contacts()
+        if watched.size == 0:
             return []
-        pairs = physics.touching_pairs()
-        if len(pairs) == 0:
+        found = physics.grasp_contacts() > 0
+        if not found[watched].any():
             return []
         events: list[ev.Event] = []
         free = self._free_toy_mask()
         if self.hand_holds is None:
-            touched = _partners(pairs, physics.hand_geom)
-            toys = _touched_toys(physics.toy_geoms, touched, free)
-            if physics.handle_geom in touched:
+            toys = found[HAND_ON_TOYS] & free
+            if found[HAND_ON_HANDLE]:
                 self.hand_holds = "stick"
                 self._hold(physics, "hand_stick", "stick")
                 events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
@@ -59,9 +89,10 @@ class PhysicalGrasp(GraspBackend):
                 free[TOYS.index(toy)] = False
                 self._hold(physics, f"hand_{toy}", toy)
                 events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
-        # A stick lying on the table catches nothing: only a stick in the hand is a tool.
+        # A stick lying on the table catches nothing: only a stick in the hand is a tool. (The
+        # hand may have taken it in this very step: its tip then catches in this step too.)
         if self.hand_holds == "stick" and self.stick_holds is None:
-            toys = _touched_toys(physics.toy_geoms, _partners(pairs, physics.tip_geom), free)
+            toys = found[TIP_ON_TOYS] & free
             if toys.any():
                 self.stick_holds = int(np.argmax(toys))
                 toy = TOYS[self.stick_holds]
@@ -140,14 +171,3 @@ class PhysicalGrasp(GraspBackend):
         nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
         contact = m.geom_size[physics.hand_geom, 0] + m.geom_size[handle, 0]
         return nearest > self.config.arm_length + contact
-
-
-def _partners(pairs: np.ndarray, geom: int) -> set[int]:
-    """Geoms in contact with `geom`, from (n, 2) contact pairs (a handful: in plain Python, as
-    this runs at every control step, faster than NumPy's masks)."""
-    return {b if a == geom else a for a, b in pairs.tolist() if geom in (a, b)}
-
-
-def _touched_toys(toy_geoms: np.ndarray, touched: set[int], free: np.ndarray) -> np.ndarray:
-    """(3,) bool: the free toys whose geom is among `touched`."""
-    return np.array([g in touched for g in toy_geoms.tolist()]) & free

@@ -4,6 +4,7 @@ the formant map's sample rows, a feedback's sound computed when read, the contex
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_DIM
 from models.world import Feedback
@@ -74,18 +75,20 @@ def test_compiled_kernels_measure_distances_as_numpy_does() -> None:
     np.testing.assert_array_equal(out, np.hypot(dx, dy))
 
 
-def test_the_compiled_rules_work_where_numba_cannot_cache(run_without_numba_cache) -> None:
-    """A read-only install without a writable home: the kinematic rules are compiled in the
-    process (no cache directory numba may use) and move the room as the cached ones do."""
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_the_compiled_rules_work_where_numba_cannot_cache(run_without_numba_cache, grasp) -> None:
+    """A read-only install without a writable home: the kinematic rules and the physical
+    control steps are compiled in the process (no cache directory numba may use) and move the
+    room as the cached ones do."""
     code = (
         "import numpy as np\n"
         "from sim import Playroom\n"
-        "room = Playroom('kinematic', seed=3)\n"
+        f"room = Playroom({grasp!r}, seed=3)\n"
         "commands = np.random.default_rng(9).uniform(-1.0, 1.0, (40, 21))\n"
         "print(np.concatenate([room.act_arm(m).s for m in commands]).tobytes().hex())\n"
     )
     printed = run_without_numba_cache(code)
-    room = Playroom("kinematic", seed=3)
+    room = Playroom(grasp, seed=3)
     commands = np.random.default_rng(9).uniform(-1.0, 1.0, (40, 21))
     here = np.concatenate([room.act_arm(m).s for m in commands]).tobytes().hex()
     assert printed == here

@@ -1,0 +1,108 @@
+"""A physical movement's control steps in compiled code (numba) calling MuJoCo's C library.
+
+Why: a physical iteration is 500 MuJoCo steps in 50 control steps, and each control step cost
+about 7 us of Python around MuJoCo's own work (setting the servos' targets, three calls into
+the bindings, reading the tracked positions and the contacts): a sixth of an iteration. Here
+one compiled loop runs the control steps and returns to Python only when a contact the grasp
+acts on appears (the grasp's rules stay in sim/grasping/physical.py).
+
+Same numbers: the loop calls the same C functions in the same order as
+`PlayroomPhysics.advance` (mj_step2, then mj_step, then mj_step1), writes the servos' targets
+and the caregiver's hand as the physical backend writes them (each operation rounded on its
+own, no fast-math), and reads positions and contact sensors from the same arrays.
+tests/world/test_compiled_steps.py holds it to the step-by-step Python loop bit for bit.
+
+MuJoCo's library is the one its Python package ships (found beside `mujoco/__init__.py`); where
+it is not found, `AVAILABLE` is False and the room steps in Python.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+from typing import Any
+
+import mujoco
+import numpy as np
+from llvmlite import binding
+from numba import types
+
+from sim.compiled import compiled
+
+
+def _mujoco_library() -> str | None:
+    """Path of the MuJoCo shared library inside the mujoco package, or None."""
+    folder = os.path.dirname(mujoco.__file__)
+    for pattern in ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll"):
+        found = sorted(glob.glob(os.path.join(folder, pattern)))
+        if found:
+            return found[0]
+    return None
+
+
+LIBRARY = _mujoco_library()
+AVAILABLE = LIBRARY is not None
+if AVAILABLE:
+    # The symbols the compiled code links to (numba's cache stores the calls by name).
+    binding.load_library_permanently(LIBRARY)
+
+# void mj_step*(const mjModel* m, mjData* d): the pointers passed as integers of their width.
+_STEP_SIGNATURE = types.void(types.uintp, types.uintp)
+mj_step: Any = types.ExternalFunction("mj_step", _STEP_SIGNATURE)
+mj_step1: Any = types.ExternalFunction("mj_step1", _STEP_SIGNATURE)
+mj_step2: Any = types.ExternalFunction("mj_step2", _STEP_SIGNATURE)
+
+
+@compiled
+def control_steps(
+    model: int,
+    data: int,
+    substeps: int,
+    start: int,
+    arm_targets: np.ndarray,
+    ctrl: np.ndarray,
+    bring_to: np.ndarray,
+    bring_rate: float,
+    hand_mocap: np.ndarray,
+    site_xpos: np.ndarray,
+    xpos: np.ndarray,
+    tracked_sites: np.ndarray,
+    tracked_bodies: np.ndarray,
+    positions: np.ndarray,
+    sensordata: np.ndarray,
+    watched: np.ndarray,
+) -> int:  # pragma: no cover - compiled; tested against the Python loop
+    """Control steps `start`, `start` + 1, ... of a movement, each `substeps` MuJoCo steps.
+
+    model, data: the addresses of the MjModel and MjData. arm_targets (n, nu): the servos'
+    targets written to ctrl (nu,) before each step, or (0, nu) to leave them. bring_to (2,):
+    where the caregiver's hand (hand_mocap, its mocap_pos row) moves `bring_rate` of the way
+    before each step, or (0,) if she brings nothing. After each step the tracked positions
+    (x, y of the sites `tracked_sites` of site_xpos, then of the bodies `tracked_bodies` of
+    xpos) fill row k + 1 of positions (n + 1, 2 * (sites + bodies)). Returns the first step k
+    after which a sensor at an address in `watched` is positive, or n.
+    """
+    n = positions.shape[0] - 1
+    n_sites = tracked_sites.shape[0]
+    for k in range(start, n):
+        if arm_targets.shape[0] > 0:
+            for j in range(ctrl.shape[0]):
+                ctrl[j] = arm_targets[k, j]
+        if bring_to.shape[0] > 0:
+            for i in range(2):
+                here = hand_mocap[i]
+                hand_mocap[i] = here + bring_rate * (bring_to[i] - here)
+        mj_step2(model, data)
+        for _ in range(substeps - 1):
+            mj_step(model, data)
+        mj_step1(model, data)
+        for i in range(n_sites):
+            positions[k + 1, 2 * i] = site_xpos[tracked_sites[i], 0]
+            positions[k + 1, 2 * i + 1] = site_xpos[tracked_sites[i], 1]
+        for i in range(tracked_bodies.shape[0]):
+            positions[k + 1, 2 * (n_sites + i)] = xpos[tracked_bodies[i], 0]
+            positions[k + 1, 2 * (n_sites + i) + 1] = xpos[tracked_bodies[i], 1]
+        for address in watched:
+            if sensordata[address] > 0:
+                return k
+    return n

@@ -1,0 +1,125 @@
+"""The physical movement's control steps run compiled (sim/compiled_steps.py): the same numbers,
+events and state as the step-by-step Python loop, and the contact sensors they watch say what
+MuJoCo's contact list says."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scripted import Waypoint, arm_command_through
+
+from models import playroom_xml
+from models.layout import ARM_DIM, VOICE_DIM
+from sim import Playroom
+from sim import events as ev
+from sim.compiled_steps import AVAILABLE
+from sim.config import world_preset
+from sim.physics import GRASP_CONTACTS, PlayroomPhysics
+
+PROJECT = world_preset("project")
+PARKED_TOYS = np.array([[-0.75, -0.55], [-0.15, -0.9], [-0.8, 0.5]])
+HANDLE = np.array([0.15, 0.1])
+TOY_ON_STICK_LINE = np.array([0.6, 0.11])
+TOY_IN_REACH = np.array([0.2, 0.25])
+BRING = "bring"  # a scene's step: the caregiver starts bringing toy m (0-based)
+
+pytestmark = pytest.mark.skipif(not AVAILABLE, reason="MuJoCo's shared library not found")
+
+
+def _command(waypoints: list[Waypoint]) -> np.ndarray:
+    m, error = arm_command_through(waypoints)
+    assert error < 0.02, f"no command follows the waypoints closely enough ({error:.3f} m)"
+    return m
+
+
+def _tool_scene(room: Playroom) -> list[tuple[str, np.ndarray]]:
+    """The hand takes the stick, whose tip then catches a toy beyond the hand's reach."""
+    room.arrange(stick=(*HANDLE, 0.0), toys=np.vstack([TOY_ON_STICK_LINE, PARKED_TOYS[1:]]))
+    waypoints = [
+        Waypoint(16, tuple(HANDLE + (-0.03, 0.02)), 0.0),
+        Waypoint(20, tuple(HANDLE + (-0.03, 0.02)), 0.0),
+        Waypoint(34, tuple(HANDLE + (0.19, 0.01)), 0.0),
+        Waypoint(50, (0.3, 0.35), 0.8),
+    ]
+    return [("arm", _command(waypoints))]
+
+
+def _toy_scene(room: Playroom) -> list[tuple[str, np.ndarray]]:
+    """The hand takes a toy and carries it; then the caregiver brings a toy while the agent
+    speaks."""
+    room.arrange(toys=np.vstack([TOY_IN_REACH, PARKED_TOYS[1:]]), caregiver=(-0.8, 0.6))
+    carry = _command([Waypoint(25, tuple(TOY_IN_REACH)), Waypoint(50, (0.35, 0.0))])
+    return [("arm", carry), (BRING, np.array(2)), ("voice", np.zeros(VOICE_DIM))]
+
+
+def _random_scene(room: Playroom) -> list[tuple[str, np.ndarray]]:
+    """Random movements of both kinds, as a trial's first iterations are."""
+    rng = np.random.default_rng(3)
+    return [
+        (space, rng.uniform(-1, 1, ARM_DIM if space == "arm" else VOICE_DIM))
+        for space in ("arm", "voice") * 12
+    ]
+
+
+def _played(scene, compiled: bool) -> tuple[Playroom, list]:
+    room = Playroom("physical", seed=0, config=PROJECT)
+    room.task.compiled_steps = compiled
+    feedbacks = []
+    for space, m in scene(room):
+        if space == BRING:
+            room.caregiver.start_bringing(room.physics, int(m))
+        else:
+            feedbacks.append(room.act(space, m))
+    return room, feedbacks
+
+
+@pytest.mark.parametrize("scene", [_tool_scene, _toy_scene, _random_scene])
+def test_compiled_steps_give_the_python_loops_numbers(scene):
+    python_room, python_feedbacks = _played(scene, compiled=False)
+    room, feedbacks = _played(scene, compiled=True)
+    for expected, got in zip(python_feedbacks, feedbacks, strict=True):
+        np.testing.assert_array_equal(got.s, expected.s)
+        np.testing.assert_array_equal(got.positions, expected.positions)
+        np.testing.assert_array_equal(got.sound, expected.sound)
+        assert got.events == expected.events
+    np.testing.assert_array_equal(room.get_state()["physics"], python_room.get_state()["physics"])
+    np.testing.assert_array_equal(room.physics.data.ptr.qacc, python_room.physics.data.ptr.qacc)
+    kinds = {kind for f in feedbacks for kind in f.kinds()}
+    if scene is _tool_scene:  # the scene does what it is meant to
+        assert {ev.STICK_GRASPED, ev.TOY_CAUGHT} <= kinds
+    if scene is _toy_scene:
+        assert ev.TOY_GRASPED in kinds
+        assert any(e.kind == ev.TOY_MOVED and e.by == "caregiver" for e in feedbacks[1].events)
+
+
+def test_contact_sensors_say_what_the_contact_list_says():
+    room = Playroom("physical", seed=0, config=PROJECT)
+    scene = _tool_scene(room)
+    p = room.physics
+    pairs = [(p.hand_geom, p.handle_geom)]
+    pairs += [(p.hand_geom, g) for g in p.toy_geoms] + [(p.tip_geom, g) for g in p.toy_geoms]
+    seen = []
+
+    def compare(step: int, observation: dict) -> None:
+        listed = {tuple(sorted(pair)) for pair in p.touching_pairs().tolist()}
+        expected = [tuple(sorted(pair)) in listed for pair in pairs]
+        sensed = list(p.grasp_contacts() > 0)
+        assert sensed == expected, f"step {step}: {dict(zip(GRASP_CONTACTS, sensed, strict=True))}"
+        seen.append(sensed)
+
+    room.step_observers.append(compare)
+    for space, m in scene:
+        room.act(space, m)
+    touched = np.array(seen).any(axis=0)
+    assert touched[0] and touched[4], "the scene touches the handle and a toy with the tip"
+
+
+def test_a_model_without_the_grasp_sensors_is_refused(tmp_path: Path):
+    xml = Path(playroom_xml()).read_text()
+    start, end = xml.index("<sensor>"), xml.index("</sensor>") + len("</sensor>")
+    path = tmp_path / "playroom.xml"
+    path.write_text(xml[:start] + xml[end:])
+    with pytest.raises(ValueError, match="no contact sensor named hand_stick"):
+        PlayroomPhysics.load(path=path)
