@@ -148,6 +148,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         # What the compiled control steps read and write (sim/compiled_steps.py).
         self._tracked_sites = np.array([self.hand_site, self.handle_site])
         self._caregiver_hand_row = d.mocap_pos[self.caregiver_hand_mocap]
+        self._warning_numbers = d.warning.number  # a view: built once, read every movement
 
     def _reload_from_data(self, data) -> None:
         super()._reload_from_data(data)
@@ -270,7 +271,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
 
     def warning_counts(self) -> np.ndarray:
         """(mjNWARNING,) how often MuJoCo has warned of each kind (a diverging state warns)."""
-        return self._mj_data.warning.number.copy()
+        return self._warning_numbers.copy()
 
     def grasp_contacts(self) -> np.ndarray:
         """(7,) how many contacts MuJoCo found between each pair of GRASP_CONTACTS, current

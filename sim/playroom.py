@@ -132,29 +132,36 @@ class Playroom:
         # (trajectory_formants) would only repeat that.
         frames = articulators.T
         closed = self._closed_form()
+        # Unobserved, the sound is no step's input (it is not physical): only what the learner
+        # and the caregiver hear, the 5 sample steps, is computed now, the other steps when the
+        # feedback's `sound` is read.
         at_samples = (
-            None if closed is None else self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
+            None
+            if self.step_observers
+            else self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
         )
-        if closed is not None and at_samples is not None:
-            # What the learner and the caregiver hear are the 5 sample steps: only those are
-            # computed now, the other steps when the feedback's `sound` is read.
+        if at_samples is not None:
             formants = np.empty((N_STEPS, 2))
             formants.fill(np.nan)  # np.full's array, without its Python wrapper
             formants[SAMPLE_STEPS] = at_samples
             whole = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))  # noqa: E731
-            feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
+            feedback = self._run_voice(closed, frames, formants)
             feedback.sound = whole
             return feedback
-        formants = self.vocal_tract.frame_formants(frames)
-        if closed is not None:
-            feedback = self._run_closed_form(closed, VOICE, voice_formants=formants)
-        else:
-            actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-            actions[:, N_JOINTS:] = frames
-            feedback = self._run(VOICE, actions, formants)
+        feedback = self._run_voice(closed, frames, self.vocal_tract.frame_formants(frames))
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
+
+    def _run_voice(
+        self, closed: ClosedForm | None, frames: np.ndarray, formants: np.ndarray
+    ) -> Feedback:
+        """A vocal movement of articulator `frames` (n_steps, 7) sounding `formants`."""
+        if closed is not None:
+            return self._run_closed_form(closed, VOICE, voice_formants=formants)
+        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
+        actions[:, N_JOINTS:] = frames
+        return self._run(VOICE, actions, formants)
 
     @property
     def words(self) -> WordAssignment:

@@ -23,6 +23,9 @@ CAREGIVER = "caregiver"
 HAND_ON_HANDLE = 0
 HAND_ON_TOYS = slice(1, 1 + len(TOYS))
 TIP_ON_TOYS = slice(1 + len(TOYS), 1 + 2 * len(TOYS))
+_WATCHED_BY_EMPTY_HAND = np.arange(TIP_ON_TOYS.start)
+_WATCHED_BY_EMPTY_TIP = np.arange(TIP_ON_TOYS.start, TIP_ON_TOYS.stop)
+_WATCHED_BY_NOTHING = np.empty(0, dtype=np.int64)
 
 
 class PhysicalGrasp(GraspBackend):
@@ -52,21 +55,21 @@ class PhysicalGrasp(GraspBackend):
         `before_step` and the caregiver's carrying would take them; while `grasping` (an arm
         movement), until a contact that would take something appears: returns that step,
         whose `after_step` the caller then takes, or n."""
-        watched = self.watched_contacts() if grasping else np.empty(0, dtype=int)
+        watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
         return physics.control_steps(
             start, arm_targets, bring_to, self.config.caregiver_bring_rate, positions, watched
         )
 
     def watched_contacts(self) -> np.ndarray:
         """Indices into GRASP_CONTACTS (sim/physics.py) of the contacts that would take
-        something now: with the hand empty, the hand on the handle or on a free toy; with the
-        stick in the hand and nothing on its tip, the tip on a free toy; otherwise none."""
-        free = self._free_toy_mask()
+        something now: with the hand empty, the hand on the handle or on a toy; with the stick
+        in the hand and nothing on its tip, the tip on a toy; otherwise none. (In both first
+        cases every toy is free: nothing else holds one.)"""
         if self.hand_holds is None:
-            return np.flatnonzero(np.concatenate(([True], free, [False] * len(TOYS))))
+            return _WATCHED_BY_EMPTY_HAND
         if self.hand_holds == "stick" and self.stick_holds is None:
-            return TIP_ON_TOYS.start + np.flatnonzero(free)
-        return np.empty(0, dtype=int)
+            return _WATCHED_BY_EMPTY_TIP
+        return _WATCHED_BY_NOTHING
 
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         watched = self.watched_contacts()
@@ -166,8 +169,14 @@ class PhysicalGrasp(GraspBackend):
             return True
         m, d = physics.model.ptr, physics.data.ptr
         handle = physics.handle_geom
-        axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z
-        centre, half = d.geom_xpos[handle, :2], m.geom_size[handle, 1]
-        nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
+        centre = d.geom_xpos[handle, :2]
         contact = m.geom_size[physics.hand_geom, 0] + m.geom_size[handle, 0]
-        return nearest > self.config.arm_length + contact
+        limit = self.config.arm_length + contact
+        # The handle's centre is a point of it: if that lies within the limit, so does the
+        # nearest point (the margin covers rounding). Most iterations end here.
+        if np.hypot(centre[0], centre[1]) < limit - 1e-9:
+            return False
+        axis = d.geom_xmat[handle].reshape(3, 3)[:2, 2]  # a capsule's axis is its local z
+        half = m.geom_size[handle, 1]
+        nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
+        return nearest > limit

@@ -79,3 +79,23 @@ def test_the_physical_return_reach_is_a_setting(reach, returned):
     assert (ev.STICK_RETURNED in feedback.kinds()) == returned
     where = DEFAULT_WORLD.stick_start_handle if returned else NEAR_LIMIT[:2]
     np.testing.assert_allclose(room.context()[:2], where, atol=1e-3)
+
+
+# Without a return reach, the handle geom (0.07 m from the handle's end along the stick) is out
+# of reach when its nearest point lies beyond the contact limit (0.546 m): sticks pointing
+# back at the base, whose handle's centre or end is the nearest point, and outward.
+@pytest.mark.parametrize(
+    ("handle_x", "angle", "lost"),
+    [
+        (0.56, np.pi, False),  # spans 0.49-0.56 m: its centre is within the limit
+        (0.60, np.pi, False),  # spans 0.53-0.60 m: its centre is not, its near end is
+        (0.63, np.pi, True),  # spans 0.56-0.63 m
+        (0.53, 0.0, False),
+        (0.55, 0.0, True),
+    ],
+)
+def test_the_physical_contact_limit_is_the_handle_geoms_nearest_point(handle_x, angle, lost):
+    config = dataclasses.replace(DEFAULT_WORLD, stick_return_reach=None)
+    room = Playroom("physical", seed=0, config=config)
+    room.arrange(stick=(handle_x, 0.0, angle), toys=PARKED_TOYS)
+    assert room.backend.stick_out_of_reach(room.physics) == lost
