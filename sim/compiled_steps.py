@@ -18,6 +18,7 @@ it is not found, `AVAILABLE` is False and the room steps in Python.
 
 from __future__ import annotations
 
+import ctypes
 import glob
 import os
 from typing import Any
@@ -53,6 +54,33 @@ mj_step1: Any = types.ExternalFunction("mj_step1", _STEP_SIGNATURE)
 mj_step2: Any = types.ExternalFunction("mj_step2", _STEP_SIGNATURE)
 
 
+# mjOption's fields that follow `gravity` and precede `disableflags` span about 230 bytes.
+_OPTION_WINDOW_INTS = 128
+SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+
+
+def disable_flags_view(model: mujoco.MjModel) -> np.ndarray | None:
+    """A (1,) int32 array over `model.opt.disableflags` in the model's own memory, through
+    which the compiled loop switches sensors off between control steps; None where it cannot
+    be found (the loop then computes them at every step: the same numbers, slower).
+
+    The bindings expose no address for an integer field of mjOption: it is found by changing
+    the field through the bindings and seeing which int changed in the memory that follows
+    `opt.gravity` (an array of the same struct, whose address they do expose); the field is
+    put back at once.
+    """
+    gravity = model.opt.gravity.__array_interface__["data"][0]
+    window = np.ctypeslib.as_array((ctypes.c_int32 * _OPTION_WINDOW_INTS).from_address(gravity))
+    before = window.copy()
+    original = model.opt.disableflags
+    model.opt.disableflags = original ^ SENSORS_OFF
+    changed = np.flatnonzero(window != before)
+    model.opt.disableflags = original
+    if len(changed) != 1 or window[changed[0]] != original:
+        return None
+    return window[changed[0] : changed[0] + 1]
+
+
 @compiled
 def control_steps(
     model: int,
@@ -71,6 +99,7 @@ def control_steps(
     positions: np.ndarray,
     sensordata: np.ndarray,
     watched: np.ndarray,
+    disable_flags: np.ndarray,
 ) -> int:  # pragma: no cover - compiled; tested against the Python loop
     """Control steps `start`, `start` + 1, ... of a movement, each `substeps` MuJoCo steps.
 
@@ -81,8 +110,14 @@ def control_steps(
     (x, y of the sites `tracked_sites` of site_xpos, then of the bodies `tracked_bodies` of
     xpos) fill row k + 1 of positions (n + 1, 2 * (sites + bodies)). Returns the first step k
     after which a sensor at an address in `watched` is positive, or n.
+
+    disable_flags (1,): the model's opt.disableflags (`disable_flags_view`), through which the
+    sensors, read only after a control step, are off during its first substeps (they feed
+    nothing back into the dynamics); or (0,) to leave them on.
     """
     n = positions.shape[0] - 1
+    switch = disable_flags.shape[0] > 0
+    flags = disable_flags[0] if switch else 0
     n_sites = tracked_sites.shape[0]
     for k in range(start, n):
         if arm_targets.shape[0] > 0:
@@ -92,9 +127,13 @@ def control_steps(
             for i in range(2):
                 here = hand_mocap[i]
                 hand_mocap[i] = here + bring_rate * (bring_to[i] - here)
+        if switch:
+            disable_flags[0] = flags | SENSORS_OFF
         mj_step2(model, data)
         for _ in range(substeps - 1):
             mj_step(model, data)
+        if switch:
+            disable_flags[0] = flags
         mj_step1(model, data)
         for i in range(n_sites):
             positions[k + 1, 2 * i] = site_xpos[tracked_sites[i], 0]

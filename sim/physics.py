@@ -149,6 +149,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._tracked_sites = np.array([self.hand_site, self.handle_site])
         self._caregiver_hand_row = d.mocap_pos[self.caregiver_hand_mocap]
         self._warning_numbers = d.warning.number  # a view: built once, read every movement
+        self._disable_flags: np.ndarray | None = None  # found at the first compiled step
 
     def _reload_from_data(self, data) -> None:
         super()._reload_from_data(data)
@@ -245,10 +246,13 @@ class PlayroomPhysics(dm_mujoco.Physics):
         positions in positions[k + 1] (n + 1, 5, 2). Returns the first step after which a
         sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. Only where
         sim.compiled_steps.AVAILABLE."""
-        from sim.compiled_steps import control_steps
+        from sim.compiled_steps import control_steps, disable_flags_view
 
         if not positions.flags.c_contiguous:  # its rows are written through a flat view
             raise ValueError("positions must be a C-contiguous (n + 1, 5, 2) array")
+        if self._disable_flags is None:
+            found = disable_flags_view(self._mj_model)
+            self._disable_flags = np.empty(0, dtype=np.int32) if found is None else found
         d = self._mj_data
         return control_steps(
             self._mj_model._address,
@@ -267,6 +271,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
             positions.reshape(len(positions), -1),
             d.sensordata,
             self.grasp_contact_adr[watched],
+            self._disable_flags,
         )
 
     def warning_counts(self) -> np.ndarray:

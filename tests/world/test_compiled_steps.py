@@ -14,7 +14,7 @@ from models import playroom_xml
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
-from sim.compiled_steps import AVAILABLE
+from sim.compiled_steps import AVAILABLE, SENSORS_OFF, disable_flags_view
 from sim.config import world_preset
 from sim.physics import GRASP_CONTACTS, PlayroomPhysics
 
@@ -123,3 +123,16 @@ def test_a_model_without_the_grasp_sensors_is_refused(tmp_path: Path):
     path.write_text(xml[:start] + xml[end:])
     with pytest.raises(ValueError, match="no contact sensor named hand_stick"):
         PlayroomPhysics.load(path=path)
+
+
+def test_the_sensors_switched_off_between_control_steps_are_back_on_after_them():
+    room = Playroom("physical", seed=0, config=PROJECT)
+    m = room.physics.model.ptr
+    view = disable_flags_view(m)
+    assert view is not None, "opt.disableflags not found in the model's memory"
+    view[0] = SENSORS_OFF  # the view is the model's field
+    assert m.opt.disableflags == SENSORS_OFF
+    view[0] = 0
+    for space, command in _random_scene(room)[:4]:
+        room.act(space, command)
+        assert m.opt.disableflags == 0
