@@ -144,6 +144,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._arm_qpos = _as_slice(self.arm_qpos)
         self._object_qpos = _as_slice(self.object_qpos)
         self._object_dof = _as_slice(self.object_dof)
+        self._arm_dof = _as_slice(self.arm_dof)
         self._object_shape = self.object_qpos.shape
         # What the compiled control steps read and write (sim/compiled_steps.py).
         self._tracked_sites = np.array([self.hand_site, self.handle_site])
@@ -218,6 +219,18 @@ class PlayroomPhysics(dm_mujoco.Physics):
         d.qpos[self._object_qpos] = poses.reshape(-1)
         d.qvel[self._object_dof] = 0.0
         mujoco.mj_kinematics(self._mj_model, self._mj_data)
+
+    def stop_objects(self) -> None:
+        """The stick's and the toys' velocities to zero."""
+        self._mj_data.qvel[self._object_dof] = 0.0
+
+    def rest_arm(self) -> None:
+        """The arm back at rest, still, with no control; the kinematics updated."""
+        d = self._mj_data
+        d.qpos[self._arm_qpos] = 0.0
+        d.qvel[self._arm_dof] = 0.0
+        d.ctrl[:] = 0.0
+        mujoco.mj_kinematics(self._mj_model, d)
 
     def advance(self, nstep: int) -> None:
         """`nstep` physics steps exactly as dm_control's `step` takes them (its legacy order:

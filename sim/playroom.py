@@ -37,6 +37,7 @@ from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.registry import make_tract
 
 _SOUND = block_slice("sound")  # where her word goes in s
+_PHYSICS_STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # what get_state keeps of MuJoCo
 
 
 class Playroom:
@@ -203,15 +204,11 @@ class Playroom:
     # Checkpoints --------------------------------------------------------------------------
     def get_state(self) -> dict:
         """Everything that decides what happens next, as plain values and arrays."""
-        m, d = self.physics.model.ptr, self.physics.data.ptr
-        spec = mujoco.mjtState.mjSTATE_INTEGRATION
-        physics_state = np.empty(mujoco.mj_stateSize(m, spec))
-        mujoco.mj_getState(m, d, physics_state, spec)
         return {
             "grasp": self.grasp,
             "seed": self.seed,
             "iteration": self.iteration,
-            "physics": physics_state,
+            "physics": self._physics_state(),
             "rng": self.rng.bit_generator.state,
             "words": [list(self.words.names), list(self.words.distractors)],
         }
@@ -220,13 +217,23 @@ class Playroom:
         """Restore a state from `get_state` of a room with the same grasp backend."""
         if state["grasp"] != self.grasp:
             raise ValueError(f"state is of a {state['grasp']!r} room, this room is {self.grasp!r}")
-        m, d = self.physics.model.ptr, self.physics.data.ptr
-        mujoco.mj_setState(m, d, np.asarray(state["physics"]), mujoco.mjtState.mjSTATE_INTEGRATION)
-        mujoco.mj_forward(m, d)
+        self._restore_physics(np.asarray(state["physics"]))
         self.iteration = int(state["iteration"])
         self.rng.bit_generator.state = state["rng"]
         names, distractors = state["words"]
         self.caregiver.words = WordAssignment(tuple(names), tuple(distractors))
+
+    def _physics_state(self) -> np.ndarray:
+        """MuJoCo's integration state (mjSTATE_INTEGRATION) of the room."""
+        m, d = self.physics.model.ptr, self.physics.data.ptr
+        state = np.empty(mujoco.mj_stateSize(m, _PHYSICS_STATE))
+        mujoco.mj_getState(m, d, state, _PHYSICS_STATE)
+        return state
+
+    def _restore_physics(self, state: np.ndarray) -> None:
+        m, d = self.physics.model.ptr, self.physics.data.ptr
+        mujoco.mj_setState(m, d, state, _PHYSICS_STATE)
+        mujoco.mj_forward(m, d)
 
     # The movement -------------------------------------------------------------------------
     def _closed_form(self) -> ClosedForm | None:
@@ -289,7 +296,8 @@ class Playroom:
         p = self.physics
         if isinstance(self.backend, ClosedForm):  # placed by kinematics alone (see above)
             mujoco.mj_forward(p.model.ptr, p.data.ptr)
-        saved = self.get_state()
+        # Only the physics changes during the steps: what a divergence puts back.
+        saved = self._physics_state()
         n = N_STEPS
         positions = np.empty((n + 1, len(TRACKED_OBJECTS), 2))
         sound = np.zeros((n, 2))
@@ -317,7 +325,7 @@ class Playroom:
         except control.PhysicsError:
             # Divergence: put everything back where it was and report it; the room goes on.
             self.task.end_movement(p)
-            self.set_state(saved)
+            self._restore_physics(saved)
             positions[1:] = positions[0]
             events = [ev.Event(ev.DIVERGED, 0)]
             said = None

@@ -14,7 +14,6 @@ from __future__ import annotations
 import abc
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from models.layout import TOYS
@@ -133,8 +132,4 @@ class ClosedForm(GraspBackend):
 
 def arm_to_rest(physics: PlayroomPhysics) -> None:
     """The arm back at rest, still, with no control."""
-    d = physics.data.ptr
-    d.qpos[physics.arm_qpos] = 0.0
-    d.qvel[physics.arm_dof] = 0.0
-    d.ctrl[:] = 0.0
-    mujoco.mj_kinematics(physics.model.ptr, d)
+    physics.rest_arm()

@@ -129,7 +129,7 @@ class PhysicalGrasp(GraspBackend):
         self.hand_holds = None
         self.stick_holds = None
         self.edits.clear(self.name)
-        physics.data.ptr.qvel[physics.object_dof] = 0.0
+        physics.stop_objects()
         arm_to_rest(physics)
 
     # The caregiver bringing a toy ---------------------------------------------------------
@@ -155,7 +155,7 @@ class PhysicalGrasp(GraspBackend):
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
         self.edits.clear(CAREGIVER)
         d = physics.data.ptr
-        d.qvel[physics.object_dof] = 0.0
+        physics.stop_objects()
         d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
 
     # The experimenter ---------------------------------------------------------------------
