@@ -136,3 +136,10 @@ def test_the_sensors_switched_off_between_control_steps_are_back_on_after_them()
     for space, command in _random_scene(room)[:4]:
         room.act(space, command)
         assert m.opt.disableflags == 0
+
+
+def test_positions_the_loop_cannot_write_in_place_are_refused():
+    room = Playroom("physical", seed=0, config=PROJECT)
+    positions = np.zeros((51, 5, 4))[:, :, :2]  # a strided view: rows not contiguous
+    with pytest.raises(ValueError, match="C-contiguous"):
+        room.physics.control_steps(0, np.zeros((50, 3)), None, 0.1, positions, np.arange(4))
