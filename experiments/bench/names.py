@@ -4,3 +4,15 @@ lists them in its help without loading a simulator (experiments/bench/sections.p
 from __future__ import annotations
 
 SECTION_NAMES = ("trial", "learner", "world", "tracking", "voice", "render", "emulated")
+# What each section measures, for the command line's help.
+SECTION_HELP = {
+    "trial": "whole trials of both backends against 500 bare mj_step (fastest of 3 runs each, "
+    "in turns); the replication's 80000-iteration trial alone and two at once (~1.5 min)",
+    "learner": "the memory's query against brute force; the learner per iteration at "
+    "10000-80000 rows a model; peak memory",
+    "world": "an arm iteration of each backend against bare mj_step",
+    "tracking": "how closely the physical arm follows its DMP targets",
+    "voice": "the fitted formant map against the exact path; the vocal part of an iteration",
+    "render": "offscreen rendering (needs OpenGL: MUJOCO_GL)",
+    "emulated": "trial and learner again under the other CPU class's settings (a second process)",
+}

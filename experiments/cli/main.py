@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 
 from experiments.batches.stored import stored_profiles
-from experiments.bench.names import SECTION_NAMES
+from experiments.bench.names import SECTION_HELP, SECTION_NAMES
 from experiments.cli.args import (
     Parser,
     VersionAction,
@@ -288,7 +289,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="the WAV file to write")
     p.set_defaults(func=cmd_say)
 
-    p = sub.add_parser("bench", help="speed figures, one `name: value unit` per line")
+    p = sub.add_parser(
+        "bench",
+        help="speed figures, one `name: value unit` per line",
+        description="Speed figures, one `name: value unit` per line; ratios are measured side "
+        "by side in one run. Sections:\n"
+        + "\n".join(
+            textwrap.fill(text, 88, initial_indent=f"  {name:<10}", subsequent_indent=" " * 12)
+            for name, text in SECTION_HELP.items()
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument(
         "section",
         nargs="*",
