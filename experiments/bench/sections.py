@@ -61,18 +61,29 @@ def world_figures(iterations: int = 100, seed: int = 0) -> Iterator[tuple[str, f
     rng = np.random.default_rng(seed)
     commands = rng.uniform(-1.0, 1.0, (iterations, ARM_DIM))
     cost = {}
-    for grasp in ("physical", "kinematic"):
+    # The physical room with its control steps compiled (as trials run) and stepped in Python
+    # (sim/task.py's reference loop): what compiling them saves.
+    for name, grasp, compiled_steps in (
+        ("physical", "physical", True),
+        ("physical_python_steps", "physical", False),
+        ("kinematic", "kinematic", True),
+    ):
         room = Playroom(grasp=grasp, seed=seed)
+        room.task.compiled_steps = compiled_steps
         # Each call plays the next command (every round's worth of them).
         play_next = functools.partial(next, map(room.act_arm, np.tile(commands, (_CALL_ROUNDS, 1))))
-        cost[grasp] = _seconds_per_call(play_next, iterations)
-    room = Playroom(grasp="physical", seed=seed)
-    m, d = room.physics.model.ptr, room.physics.data.ptr
+        cost[name] = _seconds_per_call(play_next, iterations)
+    m, d = _bare_physics(seed)
     n_steps = N_STEPS * CONTROL_SUBSTEPS
     bare = _seconds_per_call(lambda: mujoco.mj_step(m, d, n_steps), iterations)
     yield "physical_arm_iteration", cost["physical"] * 1e3, "ms"
     yield f"bare_mj_step_x{n_steps}", bare * 1e3, "ms"
     yield "physical_arm_iteration_over_bare_mj_step", cost["physical"] / bare, "ratio"
+    yield (
+        "physical_arm_iteration_compiled_over_python_steps",
+        cost["physical"] / cost["physical_python_steps"],
+        "ratio",
+    )
     yield "kinematic_arm_iteration", cost["kinematic"] * 1e3, "ms"
     yield "kinematic_over_physical", cost["kinematic"] / cost["physical"], "ratio"
 
@@ -247,10 +258,20 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
         yield f"paper_profile_on_{cores}_cores", total / cores / 3600, "h (running, projected)"
 
 
-def _bare_step_seconds(n_steps: int) -> float:
-    """Seconds of `n_steps` bare mj_step calls in a fresh physical room."""
-    room = Playroom(grasp="physical", seed=0)
+def _bare_physics(seed: int = 0) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """The model and data of a fresh physical room, for bare steps: the physics alone, its
+    sensors off. (The grasp's contact sensors, added to the model after the ratios' targets
+    were set, cost 5% of a bare step; a trial computes them once a control step, at its last
+    MuJoCo step.)"""
+    room = Playroom(grasp="physical", seed=seed)
     m, d = room.physics.model.ptr, room.physics.data.ptr
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    return m, d
+
+
+def _bare_step_seconds(n_steps: int) -> float:
+    """Seconds of `n_steps` bare mj_step calls in a fresh physical room (`_bare_physics`)."""
+    m, d = _bare_physics()
     return _seconds_per_call(lambda: mujoco.mj_step(m, d, n_steps), 100)
 
 
