@@ -45,6 +45,7 @@ from experiments.file_names import (
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run import stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
@@ -212,6 +213,7 @@ def run_batch(
         if skipped and progress:
             tqdm.write(f"skipping {skipped} complete trial(s)", file=sys.stderr)
         for future in as_completed(futures):
+            stop_requests.raise_if_requested()  # one dropped in a finalizer (see there)
             name = futures[future]
             try:
                 results[name] = future.result()

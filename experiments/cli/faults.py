@@ -25,6 +25,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from experiments.cli.args import UsageError
+from experiments.run import stop_requests
+from experiments.run.stop_requests import Terminated
 from sim.vocal.diva.data import DivaDataMissing
 
 EXIT_FAULT = 1
@@ -33,32 +35,27 @@ EXIT_SIGINT = 128 + signal.SIGINT
 EXIT_SIGTERM = 128 + signal.SIGTERM
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised in the main thread as Ctrl-C raises KeyboardInterrupt: every `finally`
-    on the way out runs (a trial's lock released, a batch's cluster closed), and no
-    `except Exception` mistakes it for a failure of the work."""
-
-
-def _raise_terminated(signum: int, frame: object) -> None:
-    raise Terminated()
-
-
 @contextmanager
 def signals_as_exceptions() -> Iterator[None]:
-    """SIGTERM raises `Terminated` while the block runs (SIGINT raises KeyboardInterrupt as
-    Python does); both handlers are restored afterwards. Outside the main thread, where no
-    handler can be set, nothing changes."""
+    """While the block runs, SIGTERM raises `Terminated` and SIGINT KeyboardInterrupt, as
+    Python does, and both are recorded so that a raise dropped inside a finalizer is raised
+    again (experiments/run/stop_requests.py); both handlers are restored afterwards. A SIGINT
+    the process was started ignoring (as under nohup) stays ignored. Outside the main thread,
+    where no handler can be set, nothing changes."""
     try:
-        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_terminated)}
+        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, stop_requests.handle)}
     except ValueError:  # not the main thread
         yield
         return
     previous[signal.SIGINT] = signal.getsignal(signal.SIGINT)
+    if previous[signal.SIGINT] is signal.default_int_handler:
+        signal.signal(signal.SIGINT, stop_requests.handle)
     try:
         yield
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        stop_requests.clear()
 
 
 def _ignore_signals() -> None:

@@ -38,6 +38,7 @@ from experiments.file_names import (
     STALE_PREFIX,
     TRIAL_ENTRIES,
 )
+from experiments.run import stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, prepare_resume
@@ -255,6 +256,7 @@ class Trial:
         word_rows: list[dict] = []
         chunk_start = self.iteration
         while self.iteration < total:
+            stop_requests.raise_if_requested()  # one dropped in a finalizer (see there)
             rows.append(self._iterate())
             self.iteration += 1
             if self.iteration % WORDS_LOG_PERIOD == 0:

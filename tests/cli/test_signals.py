@@ -147,3 +147,34 @@ def test_sigterm_raises_in_the_block_and_the_handlers_are_restored():
             for _ in range(1000):  # the handler runs at the next bytecode boundaries
                 time.sleep(0.001)
     assert (signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)) == before
+
+
+def test_a_stop_raised_inside_a_finalizer_still_stops_the_run(tmp_path, monkeypatch, capsys):
+    """Python drops an exception raised in a `__del__` (pyarrow's ParquetWriter has one, run
+    after each log chunk): the stop it carried is raised again at the next iteration."""
+    from experiments.cli.main import main
+    from experiments.run import trial as trial_module
+
+    class SignalsWhenCollected:
+        def __del__(self) -> None:
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):  # the handler runs here, inside the finalizer
+                time.sleep(0.0001)
+
+    write_table = trial_module.storage.write_table
+
+    def write_then_collect(*args, **kwargs):
+        write_table(*args, **kwargs)
+        SignalsWhenCollected()  # collected at once: the signal arrives in its __del__
+
+    monkeypatch.setattr(trial_module.storage, "write_table", write_then_collect)
+    dropped: list = []  # what Python drops: exceptions raised in finalizers
+    monkeypatch.setattr(sys, "unraisablehook", dropped.append)
+    out = tmp_path / "trial"
+    args = ["run", "--out", str(out), "--iterations", "400", "--checkpoint-every", "50"]
+    code = main([*args, "--quiet"])
+    err = capsys.readouterr().err
+    assert [type(d.exc_value).__name__ for d in dropped] == ["Terminated"]  # the first raise
+    assert code == 143, err
+    assert err.strip().splitlines()[-1].startswith("playroom run: interrupted")
+    assert _checkpointed(out) == 50  # stopped in the chunk after the first one
