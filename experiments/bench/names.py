@@ -10,7 +10,8 @@ SECTION_HELP = {
     "in turns); the replication's 80000-iteration trial alone and two at once (~1.5 min)",
     "learner": "the memory's query against brute force; the learner per iteration at "
     "10000-80000 rows a model; peak memory",
-    "world": "an arm iteration of each backend against bare mj_step",
+    "world": "an arm iteration of each backend against bare mj_step; how slowly the Python "
+    "run after MuJoCo's steps comes back on this machine",
     "tracking": "how closely the physical arm follows its DMP targets",
     "voice": "the fitted formant map against the exact path; the vocal part of an iteration",
     "render": "offscreen rendering (needs OpenGL: MUJOCO_GL)",

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator
 import mujoco
 import numpy as np
 
+from experiments.bench.idle import idle_figures
 from experiments.bench.names import SECTION_NAMES
 from experiments.bench.tracking import hand_tracking_errors
 from experiments.bench.trials import (
@@ -86,6 +87,7 @@ def world_figures(iterations: int = 100, seed: int = 0) -> Iterator[tuple[str, f
     )
     yield "kinematic_arm_iteration", cost["kinematic"] * 1e3, "ms"
     yield "kinematic_over_physical", cost["kinematic"] / cost["physical"], "ratio"
+    yield from idle_figures(seed)
 
 
 def tracking_figures(n_commands: int = 1000) -> Iterator[tuple[str, float, str]]:
