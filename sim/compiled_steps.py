@@ -1,15 +1,18 @@
 """A physical movement's control steps in compiled code (numba) calling MuJoCo's C library.
 
 Why: a physical iteration is 500 MuJoCo steps in 50 control steps, and each control step cost
-about 7 us of Python around MuJoCo's own work (setting the servos' targets, three calls into
-the bindings, reading the tracked positions and the contacts): a sixth of an iteration. Here
-one compiled loop runs the control steps and returns to Python only when a contact the grasp
-acts on appears (the grasp's rules stay in sim/grasping/physical.py).
+4-7 us of Python around MuJoCo's own work (setting the servos' targets, three calls into the
+bindings, reading the tracked positions and the contacts): up to a sixth of an arm iteration
+(`playroom bench world`, `physical_arm_iteration_compiled_over_python_steps`). Here one
+compiled loop runs the control steps and returns to Python only when a contact the grasp acts
+on appears (the grasp's rules stay in sim/grasping/physical.py).
 
 Same numbers: the loop calls the same C functions in the same order as
 `PlayroomPhysics.advance` (mj_step2, then mj_step, then mj_step1), writes the servos' targets
 and the caregiver's hand as the physical backend writes them (each operation rounded on its
-own, no fast-math), and reads positions and contact sensors from the same arrays.
+own, no fast-math), and reads positions and contact sensors from the same arrays. The sensors
+are off during a control step's first substeps (`disable_flags_view`): they feed nothing back
+into the dynamics, and are read only after the last.
 tests/world/test_compiled_steps.py holds it to the step-by-step Python loop bit for bit.
 
 MuJoCo's library is the one its Python package ships (found beside `mujoco/__init__.py`); where
