@@ -96,9 +96,9 @@ def control_steps(
     bring_rate: float,
     hand_mocap: np.ndarray,
     site_xpos: np.ndarray,
+    site_indices: np.ndarray,
     xpos: np.ndarray,
-    tracked_sites: np.ndarray,
-    tracked_bodies: np.ndarray,
+    body_indices: np.ndarray,
     positions: np.ndarray,
     sensordata: np.ndarray,
     watched: np.ndarray,
@@ -109,10 +109,10 @@ def control_steps(
     model, data: the addresses of the MjModel and MjData. arm_targets (n, nu): the servos'
     targets written to ctrl (nu,) before each step, or (0, nu) to leave them. bring_to (2,):
     where the caregiver's hand (hand_mocap, its mocap_pos row) moves `bring_rate` of the way
-    before each step, or (0,) if she brings nothing. After each step the tracked positions
-    (x, y of the sites `tracked_sites` of site_xpos, then of the bodies `tracked_bodies` of
-    xpos) fill row k + 1 of positions (n + 1, 2 * (sites + bodies)). Returns the first step k
-    after which a sensor at an address in `watched` is positive, or n.
+    before each step, or (0,) if she brings nothing. After each step row k + 1 of positions
+    (n + 1, m) takes the flat site_xpos at `site_indices`, then the flat xpos at
+    `body_indices` (m in all), as `PlayroomPhysics.write_tracked_positions` reads them.
+    Returns the first step k after which a sensor at an address in `watched` is positive, or n.
 
     disable_flags (1,): the model's opt.disableflags (`disable_flags_view`), through which the
     sensors, read only after a control step, are off during its first substeps (they feed
@@ -121,7 +121,7 @@ def control_steps(
     n = positions.shape[0] - 1
     switch = disable_flags.shape[0] > 0
     flags = disable_flags[0] if switch else 0
-    n_sites = tracked_sites.shape[0]
+    n_sites = site_indices.shape[0]
     for k in range(start, n):
         if arm_targets.shape[0] > 0:
             for j in range(ctrl.shape[0]):
@@ -139,11 +139,9 @@ def control_steps(
             disable_flags[0] = flags
         mj_step1(model, data)
         for i in range(n_sites):
-            positions[k + 1, 2 * i] = site_xpos[tracked_sites[i], 0]
-            positions[k + 1, 2 * i + 1] = site_xpos[tracked_sites[i], 1]
-        for i in range(tracked_bodies.shape[0]):
-            positions[k + 1, 2 * (n_sites + i)] = xpos[tracked_bodies[i], 0]
-            positions[k + 1, 2 * (n_sites + i) + 1] = xpos[tracked_bodies[i], 1]
+            positions[k + 1, i] = site_xpos[site_indices[i]]
+        for i in range(body_indices.shape[0]):
+            positions[k + 1, n_sites + i] = xpos[body_indices[i]]
         for address in watched:
             if sensordata[address] > 0:
                 return k

@@ -146,8 +146,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._object_dof = _as_slice(self.object_dof)
         self._arm_dof = _as_slice(self.arm_dof)
         self._object_shape = self.object_qpos.shape
-        # What the compiled control steps read and write (sim/compiled_steps.py).
-        self._tracked_sites = np.array([self.hand_site, self.handle_site])
+        # What the compiled control steps write (sim/compiled_steps.py).
         self._caregiver_hand_row = d.mocap_pos[self.caregiver_hand_mocap]
         self._warning_numbers = d.warning.number  # a view: built once, read every movement
         self._disable_flags: np.ndarray | None = None  # found at the first compiled step
@@ -277,10 +276,10 @@ class PlayroomPhysics(dm_mujoco.Physics):
             np.empty(0) if bring_to is None else bring_to,
             bring_rate,
             self._caregiver_hand_row,
-            d.site_xpos,
-            d.xpos,
-            self._tracked_sites,
-            self.toy_bodies,
+            self._site_xpos_flat,
+            self._hand_handle_flat,
+            self._xpos_flat,
+            self._toys_flat,
             positions.reshape(len(positions), -1),
             d.sensordata,
             self.grasp_contact_adr[watched],

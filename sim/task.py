@@ -14,7 +14,6 @@ act in: environments that act, one command a step, are in sim/envs/.
 from __future__ import annotations
 
 import collections
-from collections.abc import Callable
 
 import numpy as np
 from dm_env import specs
@@ -109,10 +108,9 @@ class PlayroomTask(control.Task):
         """
         from sim.compiled_steps import AVAILABLE
 
-        stepper = getattr(self.grasp, "run_steps", None)
         sound_known = self.movement == ARM or self._planned_sound is not None
-        if self.compiled_steps and AVAILABLE and stepper is not None and sound_known:
-            return self._run_compiled(stepper, physics, actions, positions, sound)
+        if self.compiled_steps and AVAILABLE and self.grasp.has_compiled_steps and sound_known:
+            return self._run_compiled(physics, actions, positions, sound)
         events: list[ev.Event] = []
         for k in range(len(actions)):
             self.before_step(actions[k], physics)
@@ -125,7 +123,6 @@ class PlayroomTask(control.Task):
 
     def _run_compiled(
         self,
-        stepper: Callable[..., int],
         physics: PlayroomPhysics,
         actions: np.ndarray,
         positions: np.ndarray,
@@ -141,12 +138,12 @@ class PlayroomTask(control.Task):
             self.sound[:] = sound[n - 1]
         bring_to = None if self.caregiver.bringing is None else self.caregiver.target(physics)
         events: list[ev.Event] = []
-        k = stepper(physics, targets, bring_to, 0, positions, grasping)
+        k = self.grasp.run_steps(physics, targets, bring_to, 0, positions, grasping)
         while k < n:  # a contact the grasp acts on, after step k
             self.step_index = k + 1
             events += self.grasp.after_step(physics, self.step_index)
             physics.write_tracked_positions(positions[k + 1])  # as the grasp left them
-            k = stepper(physics, targets, bring_to, k + 1, positions, grasping)
+            k = self.grasp.run_steps(physics, targets, bring_to, k + 1, positions, grasping)
         self.step_index = n
         return events
 

@@ -34,6 +34,8 @@ class GraspBackend(abc.ABC):
     name: str
     physics_class: type[PlayroomPhysics] = PlayroomPhysics
     solid: bool
+    # Whether `run_steps` runs a movement's control steps in compiled code (PlayroomTask).
+    has_compiled_steps = False
 
     def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
         self.config = config
@@ -56,6 +58,21 @@ class GraspBackend(abc.ABC):
     @abc.abstractmethod
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         """Look at the world after the step and attach what the rules say."""
+
+    def run_steps(
+        self,
+        physics: PlayroomPhysics,
+        arm_targets: np.ndarray,
+        bring_to: np.ndarray | None,
+        start: int,
+        positions: np.ndarray,
+        grasping: bool,
+    ) -> int:
+        """Control steps from `start` in compiled code, as `before_step` and the caregiver's
+        carrying would take them; while `grasping` (an arm movement), until a contact that
+        would take something appears: returns that step, whose `after_step` the caller then
+        takes, or n. Only for a backend with `has_compiled_steps`."""
+        raise NotImplementedError(f"the {self.name} backend has no compiled steps")
 
     def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         """A control step of a vocal movement, the arm at rest: nothing is grasped."""

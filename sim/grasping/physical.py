@@ -32,6 +32,7 @@ class PhysicalGrasp(GraspBackend):
     """Grasps by contact, held by welds; every object a solid body."""
 
     name = "physical"
+    has_compiled_steps = True
     physics_class = PlayroomPhysics
     solid = True
 
@@ -51,10 +52,7 @@ class PhysicalGrasp(GraspBackend):
         positions: np.ndarray,
         grasping: bool,
     ) -> int:
-        """Control steps from `start` in compiled code (PlayroomPhysics.control_steps), as
-        `before_step` and the caregiver's carrying would take them; while `grasping` (an arm
-        movement), until a contact that would take something appears: returns that step,
-        whose `after_step` the caller then takes, or n."""
+        """`GraspBackend.run_steps`, through PlayroomPhysics.control_steps."""
         watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
         return physics.control_steps(
             start, arm_targets, bring_to, self.config.caregiver_bring_rate, positions, watched
@@ -78,10 +76,10 @@ class PhysicalGrasp(GraspBackend):
         found = physics.grasp_contacts() > 0
         if not found[watched].any():
             return []
+        # Wherever a contact is watched every toy is free (`watched_contacts`).
         events: list[ev.Event] = []
-        free = self._free_toy_mask()
         if self.hand_holds is None:
-            toys = found[HAND_ON_TOYS] & free
+            toys = found[HAND_ON_TOYS]
             if found[HAND_ON_HANDLE]:
                 self.hand_holds = "stick"
                 self._hold(physics, "hand_stick", "stick")
@@ -89,13 +87,12 @@ class PhysicalGrasp(GraspBackend):
             elif toys.any():
                 toy = TOYS[int(np.argmax(toys))]
                 self.hand_holds = toy
-                free[TOYS.index(toy)] = False
                 self._hold(physics, f"hand_{toy}", toy)
                 events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
         # A stick lying on the table catches nothing: only a stick in the hand is a tool. (The
         # hand may have taken it in this very step: its tip then catches in this step too.)
         if self.hand_holds == "stick" and self.stick_holds is None:
-            toys = found[TIP_ON_TOYS] & free
+            toys = found[TIP_ON_TOYS]
             if toys.any():
                 self.stick_holds = int(np.argmax(toys))
                 toy = TOYS[self.stick_holds]
