@@ -1,9 +1,9 @@
 """How this machine treats code left idle: the Python a physical iteration runs after its MuJoCo
 steps, timed back to back and right after those steps or a Python busy loop as long.
 
-Why: on the shared development machine the same calls took 16-22 us back to back and 180-300
-us right after 500 `mj_step` (README, *Speed*), and the physical ratio carries that; a
-kinematic iteration never leaves its Python idle. These figures tell a machine where that
+Why: on the shared development machine these calls took 19 us back to back and 222 us right
+after 500 `mj_step` (README, *Speed*), and the physical ratio carries that; a kinematic
+iteration never leaves its Python idle. These figures tell a machine where that
 holds from one where it does not.
 """
 
