@@ -110,7 +110,7 @@ class PlayroomTask(control.Task):
 
         sound_known = self.movement == ARM or self._planned_sound is not None
         if self.compiled_steps and AVAILABLE and self.grasp.has_compiled_steps and sound_known:
-            return self._run_compiled(physics, actions, positions, sound)
+            return self._run_compiled(physics, actions[:, :N_JOINTS], positions, sound)
         events: list[ev.Event] = []
         for k in range(len(actions)):
             self.before_step(actions[k], physics)
@@ -124,14 +124,15 @@ class PlayroomTask(control.Task):
     def _run_compiled(
         self,
         physics: PlayroomPhysics,
-        actions: np.ndarray,
+        joint_targets: np.ndarray,
         positions: np.ndarray,
         sound: np.ndarray,
     ) -> list[ev.Event]:
-        n = len(actions)
+        """`run_steps` through the backend's compiled steps, joint_targets (n, 3) the arm's."""
+        n = len(joint_targets)
         grasping = self.movement == ARM
         if grasping:
-            targets = np.ascontiguousarray(actions[:, :N_JOINTS])
+            targets = np.ascontiguousarray(joint_targets)
         else:  # the arm rests; the sound is the planned one, step by step
             targets = np.empty((0, N_JOINTS))
             sound[:] = self._planned_sound
