@@ -55,6 +55,15 @@ _STEP_SIGNATURE = types.void(types.uintp, types.uintp)
 mj_step: Any = types.ExternalFunction("mj_step", _STEP_SIGNATURE)
 mj_step1: Any = types.ExternalFunction("mj_step1", _STEP_SIGNATURE)
 mj_step2: Any = types.ExternalFunction("mj_step2", _STEP_SIGNATURE)
+# void mj_getState(m, d, mjtNum* state, int sig) and mj_setState(m, d, const mjtNum*, int sig)
+_STATE_SIGNATURE = types.void(types.uintp, types.uintp, types.uintp, types.intc)
+mj_getState: Any = types.ExternalFunction("mj_getState", _STATE_SIGNATURE)
+mj_setState: Any = types.ExternalFunction("mj_setState", _STATE_SIGNATURE)
+
+# What a control step starting from a state computes from (MuJoCo's "integration" state, which
+# reproduces a step), less the time, which nothing in the room's dynamics reads.
+_TIME = int(mujoco.mjtState.mjSTATE_TIME)
+DYNAMIC_STATE = int(mujoco.mjtState.mjSTATE_INTEGRATION) & ~_TIME
 
 
 # mjOption's fields that follow `gravity` and precede `disableflags` span about 230 bytes.
@@ -103,6 +112,10 @@ def control_steps(
     sensordata: np.ndarray,
     watched: np.ndarray,
     disable_flags: np.ndarray,
+    rest: np.ndarray,
+    warnings: np.ndarray,
+    timestep: float,
+    computed: np.ndarray,
 ) -> int:  # pragma: no cover - compiled; tested against the Python loop
     """Control steps `start`, `start` + 1, ... of a movement, each `substeps` MuJoCo steps.
 
@@ -117,11 +130,23 @@ def control_steps(
     disable_flags (1,): the model's opt.disableflags (`disable_flags_view`), through which the
     sensors, read only after a control step, are off during its first substeps (they feed
     nothing back into the dynamics); or (0,) to leave them on.
+
+    rest (2, mj_stateSize(DYNAMIC_STATE)): room for two states, or (0, ...) to step every
+    control step. With room, no targets and no one bringing, every control step starts from
+    the same inputs; once one leaves the state (DYNAMIC_STATE) bit for bit as it found it and
+    raises no warning (everything at rest), every later one would too: they are not computed,
+    the time (`timestep` per MuJoCo step) advances as MuJoCo's additions would advance it and
+    their positions are the last ones. warnings: MuJoCo's warning counts (mjData.warning's
+    `number`). computed[0] grows by one per control step computed.
     """
     n = positions.shape[0] - 1
     switch = disable_flags.shape[0] > 0
     flags = disable_flags[0] if switch else 0
     n_sites = site_indices.shape[0]
+    may_rest = rest.shape[0] == 2 and arm_targets.shape[0] == 0 and bring_to.shape[0] == 0
+    before, after = rest[0], rest[1] if rest.shape[0] == 2 else rest[0]
+    if may_rest:
+        mj_getState(model, data, before.ctypes.data, DYNAMIC_STATE)
     for k in range(start, n):
         if arm_targets.shape[0] > 0:
             for j in range(ctrl.shape[0]):
@@ -130,6 +155,7 @@ def control_steps(
             for i in range(2):
                 here = hand_mocap[i]
                 hand_mocap[i] = here + bring_rate * (bring_to[i] - here)
+        warned = warnings.sum()
         if switch:
             disable_flags[0] = flags | SENSORS_OFF
         mj_step2(model, data)
@@ -138,6 +164,7 @@ def control_steps(
         if switch:
             disable_flags[0] = flags
         mj_step1(model, data)
+        computed[0] += 1
         for i in range(n_sites):
             positions[k + 1, i] = site_xpos[site_indices[i]]
         for i in range(body_indices.shape[0]):
@@ -145,4 +172,42 @@ def control_steps(
         for address in watched:
             if sensordata[address] > 0:
                 return k
+        if may_rest and k + 1 < n:
+            mj_getState(model, data, after.ctypes.data, DYNAMIC_STATE)
+            if warnings.sum() == warned and _same_bits(before, after):
+                _rest_until(model, data, n - 1 - k, substeps, timestep, positions, k + 1)
+                return n
+            before, after = after, before
     return n
+
+
+@compiled
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover - compiled
+    """Whether two float64 vectors hold the same bits (0.0 and -0.0 differ, a NaN never
+    matches: a state holding one is not at rest)."""
+    a_bits, b_bits = a.view(np.int64), b.view(np.int64)
+    for i in range(a_bits.shape[0]):
+        if a_bits[i] != b_bits[i] or a[i] != a[i]:
+            return False
+    return True
+
+
+@compiled
+def _rest_until(
+    model: int,
+    data: int,
+    control_steps: int,
+    substeps: int,
+    timestep: float,
+    positions: np.ndarray,
+    row: int,
+) -> None:  # pragma: no cover - compiled; tested against the Python loop
+    """The end of `control_steps` control steps at rest: MuJoCo's time advanced by one
+    `timestep` addition per step, as mj_step advances it, and their positions row's copies."""
+    time = np.empty(1)
+    mj_getState(model, data, time.ctypes.data, _TIME)
+    for _ in range(control_steps * substeps):
+        time[0] = time[0] + timestep
+    mj_setState(model, data, time.ctypes.data, _TIME)
+    for k in range(row + 1, row + 1 + control_steps):
+        positions[k] = positions[row]

@@ -150,6 +150,9 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self._caregiver_hand_row = d.mocap_pos[self.caregiver_hand_mocap]
         self._warning_numbers = d.warning.number  # a view: built once, read every movement
         self._disable_flags: np.ndarray | None = None  # found at the first compiled step
+        self._rest_states: np.ndarray | None = None  # room for two states, at the first one
+        # Control steps the compiled loop has computed (the others found the room at rest).
+        self.control_steps_computed = np.zeros(1, dtype=np.int64)
 
     def _reload_from_data(self, data) -> None:
         super()._reload_from_data(data)
@@ -256,15 +259,19 @@ class PlayroomPhysics(dm_mujoco.Physics):
         targets arm_targets[k] (n, 3) (or, if empty, left as they are) and the caregiver's hand
         `bring_rate` of the way to bring_to (2,) (or None: not moved); after each, the tracked
         positions in positions[k + 1] (n + 1, 5, 2). Returns the first step after which a
-        sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. Only where
+        sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. With no targets
+        and nothing brought, the steps after one that leaves the room's state as it found it
+        (all at rest) are not computed: only the time moves (sim.compiled_steps). Only where
         sim.compiled_steps.AVAILABLE."""
-        from sim.compiled_steps import control_steps, disable_flags_view
+        from sim.compiled_steps import DYNAMIC_STATE, control_steps, disable_flags_view
 
         if not positions.flags.c_contiguous:  # its rows are written through a flat view
             raise ValueError("positions must be a C-contiguous (n + 1, 5, 2) array")
-        if self._disable_flags is None:
+        if self._disable_flags is None or self._rest_states is None:
             found = disable_flags_view(self._mj_model)
             self._disable_flags = np.empty(0, dtype=np.int32) if found is None else found
+            size = mujoco.mj_stateSize(self._mj_model, DYNAMIC_STATE)
+            self._rest_states = np.empty((2, size))
         d = self._mj_data
         return control_steps(
             self._mj_model._address,
@@ -284,6 +291,10 @@ class PlayroomPhysics(dm_mujoco.Physics):
             d.sensordata,
             self.grasp_contact_adr[watched],
             self._disable_flags,
+            self._rest_states,
+            self._warning_numbers,
+            self._mj_model.opt.timestep,
+            self.control_steps_computed,
         )
 
     def warning_counts(self) -> np.ndarray:

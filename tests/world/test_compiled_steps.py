@@ -143,3 +143,35 @@ def test_positions_the_loop_cannot_write_in_place_are_refused():
     positions = np.zeros((51, 5, 4))[:, :, :2]  # a strided view: rows not contiguous
     with pytest.raises(ValueError, match="C-contiguous"):
         room.physics.control_steps(0, np.zeros((50, 3)), None, 0.1, positions, np.arange(4))
+
+
+def _voice_after_an_arm_movement(compiled: bool, push_toy: bool) -> tuple[Playroom, object]:
+    """An arm movement, then a voice movement in which the caregiver brings nothing; with
+    `push_toy`, a toy is still sliding when the voice movement begins."""
+    room = Playroom("physical", seed=0, config=PROJECT)
+    room.task.compiled_steps = compiled
+    room.act("arm", np.random.default_rng(5).uniform(-1, 1, ARM_DIM))
+    if push_toy:
+        room.physics.data.qvel[room.physics.object_dof[1, 0]] = 0.5
+    computed = room.physics.control_steps_computed[0]
+    feedback = room.act("voice", np.zeros(VOICE_DIM))
+    assert room.caregiver.bringing is None
+    return room, (feedback, room.physics.control_steps_computed[0] - computed)
+
+
+@pytest.mark.parametrize("push_toy", [False, True])
+def test_a_voice_movement_at_rest_is_not_stepped_yet_ends_in_the_stepped_state(push_toy):
+    python_room, (expected, _) = _voice_after_an_arm_movement(compiled=False, push_toy=push_toy)
+    room, (got, computed) = _voice_after_an_arm_movement(compiled=True, push_toy=push_toy)
+    np.testing.assert_array_equal(got.positions, expected.positions)
+    np.testing.assert_array_equal(got.s, expected.s)
+    assert got.events == expected.events
+    d, python_d = room.physics.data.ptr, python_room.physics.data.ptr
+    assert d.time == python_d.time  # 500 steps' time, whether stepped or not
+    for field in ("qpos", "qvel", "qacc", "qacc_warmstart", "sensordata", "xpos", "site_xpos"):
+        np.testing.assert_array_equal(getattr(d, field), getattr(python_d, field), err_msg=field)
+    if push_toy:  # the toy slides (slower and slower) through the whole movement
+        assert computed == 50
+        assert not np.array_equal(got.positions[0, 2], got.positions[-1, 2])
+    else:  # the arm's last push decays within the first steps; then nothing moves
+        assert computed < 5
