@@ -20,7 +20,7 @@ import sys
 import threading
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import CancelledError
 from pathlib import Path
 
@@ -55,6 +55,8 @@ from experiments.run.trial_files import TrialError, check_identity
 # How long a batch task waits for another writer of its trial to finish (s): longer than a
 # trial of the paper profile takes on one core.
 LOCK_WAIT_S = 4 * 3600
+# How often a batch waiting for its trials looks for a stop request Python dropped (s).
+STOP_POLL_S = 0.2
 
 
 def is_complete(trial_dir: Path) -> bool:
@@ -158,8 +160,6 @@ def run_batch(
     done across the trials, moved at most every `report_interval_s` by each trial (looked at
     every `report_every` iterations)
     (experiments/batches/progress.py)."""
-    from distributed import as_completed
-
     # Workers may run in another directory, or on another machine sharing the file system:
     # they are sent the path the user meant, not one relative to where they run.
     out = Path(os.path.abspath(Path(out_dir).expanduser()))
@@ -212,8 +212,7 @@ def run_batch(
             futures[future] = name
         if skipped and progress:
             tqdm.write(f"skipping {skipped} complete trial(s)", file=sys.stderr)
-        for future in as_completed(futures):
-            stop_requests.raise_if_requested()  # one dropped in a finalizer (see there)
+        for future in _as_finished(futures):
             name = futures[future]
             try:
                 results[name] = future.result()
@@ -240,6 +239,24 @@ def run_batch(
         listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
         raise BatchError(f"{len(failures)} trial(s) failed: {listed}")
     return results
+
+
+def _as_finished(futures: dict) -> Iterator:
+    """The futures as they finish (distributed's `as_completed`), looking every
+    STOP_POLL_S, while none finishes, for a stop request whose exception Python dropped in a
+    finalizer (experiments/run/stop_requests.py): as_completed alone would wait for the next
+    trial to end, minutes, before the batch heard it."""
+    from distributed import as_completed
+
+    finished = as_completed(futures)
+    while finished.count():
+        stop_requests.raise_if_requested()
+        ready = finished.next_batch(block=False)
+        if not ready:
+            time.sleep(STOP_POLL_S)
+        for future in ready:
+            stop_requests.raise_if_requested()
+            yield future
 
 
 def _record(spec: BatchSpec, out: Path) -> None:

@@ -178,3 +178,39 @@ def test_a_stop_raised_inside_a_finalizer_still_stops_the_run(tmp_path, monkeypa
     assert code == 143, err
     assert err.strip().splitlines()[-1].startswith("playroom run: interrupted")
     assert _checkpointed(out) == 50  # stopped in the chunk after the first one
+
+
+@pytest.mark.slow  # a cluster of its own: over 5 s
+def test_a_batch_waiting_for_its_trials_hears_a_stop_python_dropped(tmp_path):
+    """A stop whose exception Python dropped (in a finalizer) while the batch waits for its
+    trials stops the batch then, not when the next trial ends."""
+    import threading
+
+    from experiments.batches.runner import run_batch
+    from experiments.batches.spec import BatchSpec
+    from experiments.run import stop_requests
+
+    spec = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=100000, checkpoint_every=50)
+    out = tmp_path / "batch"
+    trial = out / "kinematic-random-seed0000"
+
+    def stop_once_the_trial_runs() -> None:
+        for _ in range(1200):  # polls every 25 ms; no clock is read
+            if _checkpointed(trial) > 0:
+                break
+            time.sleep(0.025)
+        try:  # the handler records the request; its exception is lost in this thread
+            stop_requests.handle(signal.SIGTERM, None)
+        except stop_requests.Terminated:
+            pass
+
+    stopper = threading.Thread(target=stop_once_the_trial_runs)
+    stopper.start()
+    try:
+        with pytest.raises(stop_requests.Terminated):
+            run_batch(spec, out, n_workers=1, progress=False)
+    finally:
+        stopper.join()
+        stop_requests.clear()
+    assert 0 < _checkpointed(trial) < 100000
+    assert _lock_is_free(trial)
