@@ -218,9 +218,17 @@ def write_table(path: Path, table: pd.DataFrame, plain: Sequence[str] = ()) -> N
     write_bytes(path, table_bytes(table, plain))
 
 
-def read_table(path: Path) -> pd.DataFrame:
+def read_table(path: Path, columns: Sequence[str] | None = None) -> pd.DataFrame:
+    """A table written by `write_table`; with `columns`, only those of them it holds (a log
+    written before a column existed lacks it), in that order: a reader that needs a few
+    columns of a wide table decodes only them."""
     try:
-        return pd.read_parquet(path)
+        if columns is None:
+            return pd.read_parquet(path)
+        import pyarrow.parquet as pq
+
+        held = set(pq.read_schema(path).names)
+        return pd.read_parquet(path, columns=[c for c in columns if c in held])
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
 

@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from experiments.analysis.logs import SOURCE_COLUMNS
+from models.layout import TOYS
 
 CURVE_POINTS = 40
 # Metric -> the column of movements it is a share of.
@@ -28,6 +29,17 @@ RATES = {
     "stick_in_reach": "all",
     "stick_returned": "all",
 }
+# The iterations log's columns `curve_rows` and `tool_numbers` read (a reader may read only
+# these: experiments/analysis/logs.read_log's `columns`).
+LOG_COLUMNS = (
+    "iteration",
+    "motor_space",
+    "stick_grasped",
+    "word_recognised",
+    "stick_distance",
+    "stick_returned",
+    *(f"{toy}_moved_by" for toy in TOYS),
+)
 
 
 def _events(log: pd.DataFrame, reach: float) -> pd.DataFrame:

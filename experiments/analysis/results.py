@@ -22,7 +22,7 @@ from typing import Any
 import pandas as pd
 
 from experiments import storage
-from experiments.analysis.curves import curve_rows, tool_numbers
+from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.log_chunks import is_trial_dir
 from experiments.analysis.logs import read_log
 from experiments.config_file import with_added_settings
@@ -225,7 +225,10 @@ def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[
 def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(iterations log, words log) of a trial; ReportError if unreadable or missing."""
     try:
-        log, words = read_log(trial_dir), read_log(trial_dir, "words")
+        # Only what the report reads of the iterations log (its curves, stick numbers and
+        # divergences): half the time of reading all of it.
+        log = read_log(trial_dir, columns=(*LOG_COLUMNS, "diverged"))
+        words = read_log(trial_dir, "words")
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
     if log.empty:

@@ -66,6 +66,14 @@ def test_each_kind_reads_in_one_line_and_the_whole_folder_does_not(trial):
     assert 'pd.read_parquet("TRIAL/log/iterations")' in readme
 
 
+def test_a_reader_of_a_few_columns_gets_them_as_the_whole_log_holds_them(trial):
+    whole = read_log(trial)
+    wanted = ["motor_space", "diverged", "no_such_column", "iteration"]
+    few = read_log(trial, columns=wanted)
+    held = [*SOURCE_COLUMNS, "motor_space", "diverged", "iteration"]  # a column none has: left out
+    pd.testing.assert_frame_equal(few, whole[held])
+
+
 def test_every_row_names_its_trial_seed_backend_and_voice(trial):
     for kind in ("iterations", "words"):
         log = pd.read_parquet(trial / LOG_DIR / kind)
