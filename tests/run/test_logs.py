@@ -74,6 +74,15 @@ def test_a_reader_of_a_few_columns_gets_them_as_the_whole_log_holds_them(trial):
     pd.testing.assert_frame_equal(few, whole[held])
 
 
+def test_a_damaged_chunk_read_for_a_few_columns_is_named(trial, tmp_path):
+    damaged = tmp_path / "trial"
+    shutil.copytree(trial, damaged)
+    chunk = sorted((damaged / LOG_DIR / "iterations").iterdir())[1]
+    chunk.write_bytes(chunk.read_bytes()[:200])
+    with pytest.raises(storage.CorruptFileError, match=f"{chunk.name} is damaged or truncated"):
+        read_log(damaged, columns=["iteration"])
+
+
 def test_every_row_names_its_trial_seed_backend_and_voice(trial):
     for kind in ("iterations", "words"):
         log = pd.read_parquet(trial / LOG_DIR / kind)
