@@ -196,18 +196,18 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover - comp
 def _rest_until(
     model: int,
     data: int,
-    control_steps: int,
+    remaining: int,
     substeps: int,
     timestep: float,
     positions: np.ndarray,
     row: int,
 ) -> None:  # pragma: no cover - compiled; tested against the Python loop
-    """The end of `control_steps` control steps at rest: MuJoCo's time advanced by one
+    """The end of `remaining` control steps at rest: MuJoCo's time advanced by one
     `timestep` addition per step, as mj_step advances it, and their positions row's copies."""
     time = np.empty(1)
     mj_getState(model, data, time.ctypes.data, _TIME)
-    for _ in range(control_steps * substeps):
+    for _ in range(remaining * substeps):
         time[0] = time[0] + timestep
     mj_setState(model, data, time.ctypes.data, _TIME)
-    for k in range(row + 1, row + 1 + control_steps):
+    for k in range(row + 1, row + 1 + remaining):
         positions[k] = positions[row]
