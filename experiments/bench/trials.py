@@ -3,6 +3,7 @@ them (voice, learning, logging, checkpoints and, for the replication's, the eval
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import tempfile
 import time
@@ -13,15 +14,20 @@ from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from models.layout import N_STEPS
 
 
-def trial_seconds_per_iteration(grasp: str, iterations: int) -> float:
-    """Seconds per iteration of a trial of the default settings in `grasp`."""
+def trial_seconds_per_iteration(grasp: str, iterations: int) -> tuple[float, float]:
+    """(seconds per iteration, share of its control steps computed) of a trial of the default
+    settings in `grasp`. The share is the compiled physical steps' (sim/compiled_steps.py: a
+    movement at rest stops computing); NaN where none ran (the kinematic backend)."""
     with tempfile.TemporaryDirectory() as out:
         settings = TrialSettings(grasp=grasp, iterations=iterations, checkpoint_every=1000)
         start = time.perf_counter()
-        run_trial(out, settings, progress=False)
-        return (time.perf_counter() - start) / iterations
+        trial = run_trial(out, settings, progress=False)
+        seconds = (time.perf_counter() - start) / iterations
+    computed = int(trial.room.physics.control_steps_computed[0])
+    return seconds, (computed / (iterations * N_STEPS) if computed else math.nan)
 
 
 def replication_trial_seconds(settings: TrialSettings, placements: int) -> tuple[float, float]:
