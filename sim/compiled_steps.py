@@ -131,20 +131,21 @@ def control_steps(
     sensors, read only after a control step, are off during its first substeps (they feed
     nothing back into the dynamics); or (0,) to leave them on.
 
-    rest (2, mj_stateSize(DYNAMIC_STATE)): room for two states, or (0, ...) to step every
-    control step. With room, no targets and no one bringing, every control step starts from
-    the same inputs; once one leaves the state (DYNAMIC_STATE) bit for bit as it found it and
-    raises no warning (everything at rest), every later one would too: they are not computed,
-    the time (`timestep` per MuJoCo step) advances as MuJoCo's additions would advance it and
-    their positions are the last ones. warnings: MuJoCo's warning counts (mjData.warning's
-    `number`). computed[0] grows by one per control step computed.
+    rest (2, mj_stateSize(DYNAMIC_STATE)): room for two states. With no targets and no one
+    bringing, every control step starts from the same inputs; once one leaves the state
+    (DYNAMIC_STATE) bit for bit as it found it and raises no warning (everything at rest),
+    every later one would too: they are not computed, the time (`timestep` per MuJoCo step)
+    advances as MuJoCo's additions would advance it and their positions are the last ones.
+    warnings: MuJoCo's warning counts (mjData.warning's `number`). computed[0] grows by one per
+    control step computed.
     """
     n = positions.shape[0] - 1
     switch = disable_flags.shape[0] > 0
     flags = disable_flags[0] if switch else 0
     n_sites = site_indices.shape[0]
-    may_rest = rest.shape[0] == 2 and arm_targets.shape[0] == 0 and bring_to.shape[0] == 0
-    before, after = rest[0], rest[1] if rest.shape[0] == 2 else rest[0]
+    may_rest = arm_targets.shape[0] == 0 and bring_to.shape[0] == 0
+    before, after = rest[0], rest[1]
+    warned = 0
     if may_rest:
         mj_getState(model, data, before.ctypes.data, DYNAMIC_STATE)
     for k in range(start, n):
@@ -155,7 +156,8 @@ def control_steps(
             for i in range(2):
                 here = hand_mocap[i]
                 hand_mocap[i] = here + bring_rate * (bring_to[i] - here)
-        warned = warnings.sum()
+        if may_rest:
+            warned = warnings.sum()
         if switch:
             disable_flags[0] = flags | SENSORS_OFF
         mj_step2(model, data)

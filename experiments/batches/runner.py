@@ -250,9 +250,9 @@ def _as_finished(futures: dict) -> Iterator:
 
     finished = as_completed(futures)
     while finished.count():
-        stop_requests.raise_if_requested()
         ready = finished.next_batch(block=False)
         if not ready:
+            stop_requests.raise_if_requested()
             time.sleep(STOP_POLL_S)
         for future in ready:
             stop_requests.raise_if_requested()
