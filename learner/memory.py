@@ -108,7 +108,9 @@ class NearestNeighbourMemory:
         if max_abs > self._scale:  # beyond the grid: widened, every row re-coded
             self._code_from(n)
         else:  # _code_from's arithmetic for one row
-            self._codes[:, n] = np.rint(stored * (CODE_MAX / self._scale))
+            self._codes[n // BLOCK_ROWS, :, n % BLOCK_ROWS] = np.rint(
+                stored * (CODE_MAX / self._scale)
+            )
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""
@@ -161,7 +163,7 @@ class NearestNeighbourMemory:
             n,
             q,
             CODE_MAX / self._scale,
-            self._squared,
+            self._block_squares,
             self._block_min,
             self._candidates,
         )
@@ -193,16 +195,18 @@ class NearestNeighbourMemory:
 
     def nbytes(self) -> int:
         """Bytes held by the preallocated arrays."""
-        arrays = (self._rows, self._codes, self._squared, self._block_min, self._candidates)
+        arrays = (self._rows, self._codes, self._block_squares, self._block_min, self._candidates)
         return sum(a.nbytes for a in arrays)
 
     def _allocate(self, capacity: int) -> None:
         """Empty arrays for `capacity` rows (the first `self._n` are copied by the caller)."""
         self._rows = np.empty((capacity, self._dim))  # float64, what the answers are made of
-        # Codes one column per row: the kernel streams each dimension's codes contiguously.
-        self._codes = np.zeros((self._dim, capacity), dtype=np.int8)
-        self._squared = np.empty(capacity, dtype=np.float32)  # the kernel's scratch
-        self._block_min = np.empty(capacity // BLOCK_ROWS + 1, dtype=np.float32)
+        # Codes block by block (learner/quantized_scan.py): row i at [i // BLOCK_ROWS, :,
+        # i % BLOCK_ROWS], so that a block's codes are contiguous and a scan one stream.
+        n_blocks = -(-capacity // BLOCK_ROWS)
+        self._codes = np.zeros((n_blocks, self._dim, BLOCK_ROWS), dtype=np.int8)
+        self._block_squares = np.empty(BLOCK_ROWS, dtype=np.float32)  # the kernel's scratch
+        self._block_min = np.empty(n_blocks + 1, dtype=np.float32)
         self._candidates = np.empty(capacity, dtype=np.intp)
 
     def _reserve(self, n_rows: int) -> None:
@@ -212,10 +216,10 @@ class NearestNeighbourMemory:
             return
         while capacity < n_rows:
             capacity *= 2
-        rows, codes = self._rows[: self._n], self._codes[:, : self._n]
+        rows, codes = self._rows[: self._n], self._codes
         self._allocate(capacity)
         self._rows[: self._n] = rows
-        self._codes[:, : self._n] = codes
+        self._codes[: len(codes)] = codes
 
     def _code_from(self, start: int) -> None:
         """Write the codes of the rows from `start` on; a value beyond the grid widens it and
@@ -225,4 +229,8 @@ class NearestNeighbourMemory:
             self._scale = _scale_for(max_abs)
             start = 0
         codes = np.rint(self._rows[start : self._n].T * (CODE_MAX / self._scale))
-        self._codes[:, start : self._n] = codes
+        for b in range(start // BLOCK_ROWS, -(-self._n // BLOCK_ROWS)):  # the blocks written
+            first, end = max(start, b * BLOCK_ROWS), min(self._n, (b + 1) * BLOCK_ROWS)
+            self._codes[b, :, first - b * BLOCK_ROWS : end - b * BLOCK_ROWS] = codes[
+                :, first - start : end - start
+            ]

@@ -32,6 +32,19 @@ def test_memory_matches_brute_force_as_it_grows(dim: int) -> None:
     np.testing.assert_array_equal(memory.rows, rows)
 
 
+def test_memory_grown_in_pieces_across_its_blocks_matches_brute_force() -> None:
+    """Rows added in pieces that start and end inside the kernel's blocks of 1024 rows, the
+    grid widened by a late piece (every block re-coded): the same answers as brute force."""
+    rng = np.random.default_rng(4)
+    rows = rng.uniform(-1, 1, (3500, 12))
+    rows[3000:] *= 3.0
+    memory = NearestNeighbourMemory(12)
+    for start, end in ((0, 700), (700, 701), (701, 2100), (2100, 3000), (3000, 3500)):
+        memory.extend(rows[start:end])
+        queries = np.vstack((rng.uniform(-1, 1, (10, 12)), rows[start:end][:10] + 1e-4))
+        _assert_brute_force(memory, rows[:end], queries)
+
+
 def test_memory_ties_and_near_ties_follow_brute_force() -> None:
     rng = np.random.default_rng(0)
     base = rng.uniform(-1, 1, (300, 12))
