@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike
 
 from learner.config import LearnerConfig, learner_preset
 from learner.interest import InterestModel
-from learner.sensorimotor_model import SensorimotorModel, changed_blocks
+from learner.sensorimotor_model import SensorimotorModel
+from learner.storing_rule import changed_blocks
 from models.layout import (
     BLOCK_DIM,
     CONTEXT_DIM,

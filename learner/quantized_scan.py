@@ -23,10 +23,10 @@ candidate are computed again, the same numbers, rather than writing every row's 
 from __future__ import annotations
 
 import math
-from typing import Any
 
-import numba
 import numpy as np
+
+from learner.compiled import F, compiled
 
 BLOCK_ROWS = 1024  # rows screened together: their float32 sums (4 KB) stay in L1
 _LANES = 16  # partial minima kept side by side, so the minimum is taken with vector compares
@@ -38,16 +38,9 @@ CODE_MAX = 127  # codes are int8 in [-127, 127]
 FAR_QUERY_CODES = 1e15
 
 
-def _compiled(function):
-    """`function` compiled by numba, cached on disk beside the package (or in the user's
-    cache) so that later processes load it in 0.2 s. Where no cache directory is writable (a
-    read-only install without a home directory) numba refuses to cache: it is then compiled
-    once per process instead, about 1 s."""
-    options: dict[str, Any] = {"nogil": True, "boundscheck": False, "fastmath": {"contract"}}
-    try:
-        return numba.njit(cache=True, **options)(function)
-    except RuntimeError:
-        return numba.njit(**options)(function)
+def _compiled(function: F) -> F:
+    """`function` compiled with multiply-adds fused (the bound of `candidate_limit` allows it)."""
+    return compiled(function, contract=True)
 
 
 @_compiled  # called by the kernel below (and callable from Python)

@@ -5,17 +5,8 @@ and answers, by nearest neighbour (docs/protocol.md §8):
 - inverse: the motor command m of the stored (c_i, s_i) nearest to (context, goal);
 - forward: the sensory block s_i of the stored (m, c_i) nearest to (command, context).
 
-Storing rule (the paper: "only when its sensory part changed"; the study's code differs,
-docs/protocol.md §11):
-- a block with a start position in the context (stick handle, toy i) changed when one of its
-  5 x, 5 y samples is more than `change_tolerance` from that start position. The context is
-  the position before the movement, so a toy grabbed before the first sample (step 1 of 50)
-  still counts as moved, which comparing the samples with each other would miss;
-- the hand block has no start in the context: it changed when a sample differs from the first
-  sample. Its start is always the rest position, reached again only by a still arm;
-- the sound block changed when a sound was heard or produced: one value is more than the
-  tolerance away from 0, the silent block the world sends. After an arm movement the caregiver
-  always speaks, so model 6 stores every arm movement.
+A model stores an experience when its own sensory block changed, by the storing rule of
+learner/storing_rule.py (the paper's, or the study's code's: docs/protocol.md §11).
 """
 
 from __future__ import annotations
@@ -25,69 +16,12 @@ from numpy.typing import ArrayLike
 
 from learner.config import LearnerConfig
 from learner.memory import NearestNeighbourMemory
-from models.layout import (
-    BLOCK_DIM,
-    CONTEXT_SLOTS,
-    MODELS,
-    MOTOR_DIMS,
-    N_SAMPLES,
-    SENSORY_BLOCKS,
-    SENSORY_DIM,
-    ModelSpec,
-    block_slice,
-    context_indices,
-)
+from learner.storing_rule import changed_blocks
+from models.layout import BLOCK_DIM, MODELS, MOTOR_DIMS, SENSORY_BLOCKS, ModelSpec
 
 __all__ = ["MODELS", "ModelSpec", "SensorimotorModel"]
 
 _INITIAL_CAPACITY = 1024  # rows preallocated per model, doubled when full
-
-
-def _reference_indices() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Where each value of s (60,) is compared to by the storing rule: (destination in s,
-    source in the context) for blocks whose start is in the context, and (destination, source
-    in s) for the hand, compared with its first sample. The sound is compared with 0."""
-    ctx_dst, ctx_src, s_dst, s_src = [], [], [], []
-    for block in SENSORY_BLOCKS:
-        if block == "sound":
-            continue
-        dims = np.arange(SENSORY_DIM)[block_slice(block)].reshape(2, N_SAMPLES)  # x row, y row
-        if block in CONTEXT_SLOTS:
-            for axis, start in enumerate(context_indices(block)):
-                ctx_dst += dims[axis].tolist()
-                ctx_src += [start] * N_SAMPLES
-        else:
-            for axis in range(2):
-                s_dst += dims[axis].tolist()
-                s_src += [dims[axis, 0]] * N_SAMPLES
-    ctx_dst_ix, ctx_src_ix, s_dst_ix, s_src_ix = (
-        np.array(a, dtype=np.intp) for a in (ctx_dst, ctx_src, s_dst, s_src)
-    )
-    return ctx_dst_ix, ctx_src_ix, s_dst_ix, s_src_ix
-
-
-_CTX_DST, _CTX_SRC, _S_DST, _S_SRC = _reference_indices()
-
-
-def changed_blocks(
-    context: np.ndarray, s: np.ndarray, tolerance: float, rule: str = "moved_from_start"
-) -> np.ndarray:
-    """The storing rule for every block of SENSORY_BLOCKS at once: (6,) bool, from a context
-    (10,) and feedback (60,). "moved_from_start": the module docstring's rule;
-    "varies_about_mean": the study's, |x - mean x| + |y - mean y| > tolerance over the block's
-    5 x and 5 y samples (F1 and F2 for the sound)."""
-    if rule == "varies_about_mean":
-        xy = s.reshape(len(SENSORY_BLOCKS), 2, N_SAMPLES)
-        # ndarray.mean's arithmetic (NumPy's sum, then the division), without its overhead.
-        about_mean = xy - np.add.reduce(xy, axis=2, keepdims=True) / N_SAMPLES
-        # np.linalg.norm(about_mean, axis=2)'s own arithmetic, without its overhead.
-        spread = np.add.reduce(np.sqrt(np.add.reduce(about_mean * about_mean, axis=2)), axis=1)
-        return spread > tolerance
-    reference = np.zeros(SENSORY_DIM)
-    reference[_CTX_DST] = context[_CTX_SRC]
-    reference[_S_DST] = s[_S_SRC]
-    moved = (np.abs(s - reference) > tolerance).reshape(len(SENSORY_BLOCKS), BLOCK_DIM)
-    return np.logical_or.reduce(moved, axis=1)  # moved.any(axis=1), without its wrapper
 
 
 class SensorimotorModel:
@@ -130,7 +64,7 @@ class SensorimotorModel:
         return self._inverse.rows[:, len(self.context_dims) :]
 
     def sensory_changed(self, context: np.ndarray, s: np.ndarray) -> bool:
-        """The storing rule (module docstring), for a full context (10,) and feedback (60,)."""
+        """The storing rule (learner/storing_rule.py) for a context (10,) and feedback (60,)."""
         changed = changed_blocks(context, s, self._tolerance, self._rule)
         return bool(changed[self._block])
 
