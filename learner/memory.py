@@ -24,11 +24,12 @@ when full (amortised O(dim)).
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from learner.quantized_scan import BLOCK_ROWS, CODE_MAX, screen_query
+from learner.quantized_scan import BLOCK_ROWS, CODE_MAX, screen_query, store_row
 
 _INITIAL_CAPACITY = 1024
 
@@ -92,25 +93,20 @@ class NearestNeighbourMemory:
     def append(self, row: ArrayLike, checked: bool = False) -> None:
         """Add one row (dim,). Raises ValueError on a wrong shape or a non-finite value, unless
         the caller has `checked` the row already (a float64 array of finite values)."""
+        values = cast(np.ndarray, row)  # as the caller checked it
         if not checked:
-            row = np.asarray(row, dtype=np.float64)
-            if row.shape != (self._dim,):
-                raise ValueError(f"memory row must have shape ({self._dim},), got {row.shape}")
-            if not np.isfinite(row).all():
+            values = np.asarray(row, dtype=np.float64)
+            if values.shape != (self._dim,):
+                raise ValueError(f"memory row must have shape ({self._dim},), got {values.shape}")
+            if not np.isfinite(values).all():
                 raise ValueError("memory row has a NaN or infinite value")
         if self._n == self._rows.shape[0]:
             self._reserve(self._n + 1)
         n = self._n
-        stored = self._rows[n]
-        stored[:] = row
         self._n = n + 1
-        max_abs = np.maximum.reduce(np.abs(stored))  # .max()'s answer, without its wrapper
-        if max_abs > self._scale:  # beyond the grid: widened, every row re-coded
-            self._code_from(n)
-        else:  # _code_from's arithmetic for one row
-            self._codes[n // BLOCK_ROWS, :, n % BLOCK_ROWS] = np.rint(
-                stored * (CODE_MAX / self._scale)
-            )
+        # _code_from's arithmetic for one row, compiled (every iteration stores a row or two).
+        if not store_row(self._rows, self._codes, n, values, self._scale):
+            self._code_from(n)  # beyond the grid: widened, every row re-coded
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""

@@ -166,9 +166,29 @@ def screen_query(
     return screen_candidates(codes, n, query, eta, rho, block_squares, block_min, candidates)
 
 
+@compiled  # no fused operations: the codes are NumPy's rint of the same product
+def store_row(rows: np.ndarray, codes: np.ndarray, n: int, row: np.ndarray, scale: float) -> bool:
+    """Write `row` (dim,) as row n of `rows` (capacity, dim) and, if no |value| exceeds the
+    grid's `scale`, its codes round(value * 127 / scale) into `codes` (as screen_candidates
+    reads them). Returns False, codes unwritten, for a row beyond the grid (the caller widens
+    the grid and re-codes every row)."""
+    largest = 0.0
+    for d in range(row.shape[0]):
+        rows[n, d] = row[d]
+        largest = max(largest, abs(row[d]))
+    if largest > scale:
+        return False
+    factor = CODE_MAX / scale
+    block, i = n // BLOCK_ROWS, n % BLOCK_ROWS
+    for d in range(row.shape[0]):
+        codes[block, d, i] = np.int8(np.rint(rows[n, d] * factor))
+    return True
+
+
 def warm_up() -> None:
-    """Load (or, on a first run, compile and cache) the kernel now rather than at the first
-    query: once per process, 0.2 s from numba's cache, about 1 s to compile."""
+    """Load (or, on a first run, compile and cache) the memory's kernels now rather than at the
+    first store and query: once per process, 0.2 s from numba's cache, about 1 s to compile."""
     codes = np.zeros((1, 1, BLOCK_ROWS), dtype=np.int8)
+    store_row(np.empty((1, 1)), codes, 0, np.zeros(1), 1.0)
     scratch = np.empty(BLOCK_ROWS, dtype=np.float32)
     screen_query(codes, 1, np.zeros(1), 1.0, scratch, scratch[:2].copy(), np.empty(1, np.intp))

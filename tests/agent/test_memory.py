@@ -126,15 +126,16 @@ def test_memory_rejects_bad_input() -> None:
 
 def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
     """`playroom bench` times the kernel's load apart from the trials: that holds only if the
-    warm-up compiles the very specialisation a memory's query calls."""
-    from learner.quantized_scan import screen_query, warm_up
+    warm-up compiles the very specialisations a memory's store and query call."""
+    from learner.quantized_scan import screen_query, store_row, warm_up
 
     warm_up()
-    loaded = set(screen_query.signatures)
+    loaded = set(screen_query.signatures), set(store_row.signatures)
     memory = NearestNeighbourMemory(14)
     memory.extend(np.random.default_rng(5).uniform(-1, 1, (100, 14)))
+    memory.append(np.full(14, 0.5), checked=True)
     memory.nearest(np.zeros(14))
-    assert set(screen_query.signatures) == loaded
+    assert (set(screen_query.signatures), set(store_row.signatures)) == loaded
 
 
 def test_memory_works_where_numba_cannot_cache(run_without_numba_cache) -> None:
