@@ -49,22 +49,19 @@ def movement_events(
     positions: np.ndarray, step_events: list[Event], brought: str | None
 ) -> list[Event]:
     """Which objects moved, when first, and by what, from (51, 5, 2) positions (row 0 = start)."""
-    objects = positions[:, 1:]  # the hand is not an object that moves
-    offsets = objects - objects[0]
-    # np.linalg.norm(offsets, axis=2)'s arithmetic (x*x + y*y, then the root) without its
-    # overhead, which was a third of this function's time.
-    dx, dy = offsets[..., 0], offsets[..., 1]
-    beyond = np.sqrt(dx * dx + dy * dy) > MOVED_DISTANCE  # (51, 4)
-    # beyond.any(axis=0).nonzero(), without the wrappers of any() and np.flatnonzero.
-    rows = np.logical_or.reduce(beyond, axis=0).nonzero()[0]
-    if rows.size == 0:  # most movements: nothing moved
+    # Compiled (it loads numba): imported at the first movement, not with the event kinds.
+    from sim.moved_kernel import NOT_MOVED, first_moved_steps
+
+    first = np.empty(positions.shape[1] - 1, dtype=np.int64)  # the hand is not an object
+    if first_moved_steps(positions, MOVED_DISTANCE, first) == 0:  # most movements
         return []
     grasped = {e.obj for e in step_events if e.kind in (TOY_GRASPED, STICK_GRASPED)}
     caught = {e.obj for e in step_events if e.kind == TOY_CAUGHT}
     moved: list[Event] = []
-    for row in rows:
+    for row, step in enumerate(first.tolist()):
+        if step == NOT_MOVED:
+            continue
         name = TRACKED_OBJECTS[1 + row]
-        step = int(beyond[:, row].argmax())
         if name == "stick":
             by = "hand" if "stick" in grasped else "push"
             moved.append(Event(STICK_MOVED, step, obj="stick", by=by))

@@ -75,6 +75,27 @@ def test_compiled_kernels_measure_distances_as_numpy_does() -> None:
     np.testing.assert_array_equal(out, np.hypot(dx, dy))
 
 
+def test_which_objects_moved_and_when_as_numpy_finds_it() -> None:
+    """sim/moved_kernel.py's first step beyond MOVED_DISTANCE, object by object, is the NumPy
+    expression's, at every scale and with offsets placed on the threshold itself."""
+    from models.layout import MOVED_DISTANCE
+    from sim.moved_kernel import NOT_MOVED, first_moved_steps
+
+    rng = np.random.default_rng(10)
+    for trial in range(3000):
+        scale = rng.choice([1e-4, MOVED_DISTANCE, 0.1])
+        positions = rng.uniform(-1, 1, (N_STEPS + 1, 5, 2))
+        positions[1:] = positions[0] + rng.normal(0, scale, (N_STEPS, 5, 2)) * (trial % 3 > 0)
+        if trial % 5 == 0:  # an offset of exactly the threshold along x: not beyond it
+            positions[7, 2] = positions[0, 2] + (MOVED_DISTANCE, 0.0)
+        offsets = positions[:, 1:] - positions[0, 1:]
+        beyond = np.linalg.norm(offsets, axis=2) > MOVED_DISTANCE
+        want = np.where(beyond.any(axis=0), beyond.argmax(axis=0), NOT_MOVED)
+        first = np.empty(4, dtype=np.int64)
+        assert first_moved_steps(positions, MOVED_DISTANCE, first) == beyond.any(axis=0).sum()
+        np.testing.assert_array_equal(first, want)
+
+
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_the_compiled_rules_work_where_numba_cannot_cache(run_without_numba_cache, grasp) -> None:
     """A read-only install without a writable home: the kinematic rules and the physical
