@@ -1,4 +1,4 @@
-"""The compiled kernel of the memory's scan: 8-bit codes screened in float32 (numba).
+"""The compiled kernels of the memory (numba): 8-bit codes screened in float32, and a row stored.
 
 Why a compiled kernel: the inverse query scans every stored row, so its cost is the bytes it
 streams. At 80000 rows a float32 copy of the ten models' keys is 46 MB, more than the
