@@ -190,6 +190,7 @@ def where_table(results: BatchResults) -> tuple[Table, str]:
     kernel, numpy and mujoco versions, host, commit) with the trials computed and evaluated
     there; trials from before provenance was recorded count as "not recorded". Returns the
     table and a sentence about trials computed on more than one machine."""
+    from experiments import provenance
     from experiments.provenance import SHORT_FIELDS
 
     where = results.provenance
@@ -214,6 +215,13 @@ def where_table(results: BatchResults) -> tuple[Table, str]:
         f"and count{'' if moved != 1 else 's'} under each."
         if moved
         else "Each trial was computed on one machine and library set."
+    )
+    # The page's own statistics are computed here: the last digits of a bootstrap interval
+    # follow this machine's BLAS kernel (OpenBLAS's SkylakeX and Haswell kernels, measured).
+    this_machine = provenance.describe(provenance.short_record(provenance.machine_record()))
+    note += (
+        f" This page's statistics were computed on {this_machine}; the last digits of their "
+        "bootstrap intervals follow that machine's BLAS kernel."
     )
     return Table(header, rows), note
 

@@ -7,6 +7,8 @@ empty in the CSV.
 
 summary.json:
 - page, batches (the batch directories read), groups (in the page's order);
+- computed_on: the machine and libraries that computed the page's statistics (provenance's
+  short record): a bootstrap interval's last digits follow its BLAS kernel;
 - per group (`by_group`): trials, seeds; `competence` per scope (all, ring1..3: the project's
   normalised competence, mean over trials with its 95% interval and n trials); `strategies`
   per region (centre, between limits, distance 1: shares of hand, tool, vocal and n tests);
@@ -34,7 +36,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from experiments import storage
+from experiments import provenance, storage
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
 from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
@@ -120,6 +122,7 @@ def page_summary(
     out: dict[str, Any] = {
         "page": page,
         "batches": batches,
+        "computed_on": provenance.short_record(provenance.machine_record()),
         "groups": list(results.groups),
         "by_group": {g: _group_numbers(results, numbers, g) for g in results.groups},
         "trials": _trial_records(results),

@@ -11,6 +11,7 @@ import re
 import pandas as pd
 import pytest
 
+from experiments import provenance
 from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
 
 
@@ -134,6 +135,12 @@ def check_summary(out, page: str, page_name: str) -> dict:
     differences; summary.csv holds the same per-group numbers. Returns the summary."""
     summary = json.loads((out / SUMMARY_JSON_FILE).read_text())
     assert summary["page"] == page_name
+    # Where the page's statistics were computed (their bootstrap bounds' last digits follow
+    # its BLAS kernel): this machine, in the summary and on the page.
+    here = provenance.short_record(provenance.machine_record())
+    assert summary["computed_on"] == here
+    said = f"This page's statistics were computed on {provenance.describe(here)}"
+    assert said in html.unescape(re.sub(r"\s+", " ", page))
     _check_page_numbers(page, summary, first_column=2)
     if "tests" in summary:
         rows = _rows(page)
