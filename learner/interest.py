@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from learner.compiled import compiled
 from learner.config import LearnerConfig
+from learner.pairwise_sum import BLOCK, pairwise_sum
 
 
 def competence(goal: np.ndarray, reached: np.ndarray) -> float:
@@ -43,6 +45,22 @@ def weighted_choice(rng: np.random.Generator, p: np.ndarray) -> int:
     return int(cdf.searchsorted(rng.random(), side="right"))
 
 
+@compiled
+def window_progress(ring: np.ndarray, n: int, half: int) -> float:  # pragma: no cover - compiled
+    """|mean of the newest `half` (<= 128) competences - mean of the `half` before them| of a
+    model whose attempt k sits at ring[k % len(ring)], n attempts made; 0 where half is 0. The
+    means are ndarray.mean's arithmetic (NumPy's sum, then the division), compiled: every
+    iteration updates one model's progress (tests/agent/test_pairwise_sum.py)."""
+    if half == 0:
+        return 0.0
+    recent = np.empty(2 * half)  # attempts n - 2 half .. n - 1, oldest first
+    for i in range(2 * half):
+        recent[i] = ring[(n - 2 * half + i) % ring.shape[0]]
+    newer = pairwise_sum(recent, half, half) / half
+    older = pairwise_sum(recent, 0, half) / half
+    return abs(newer - older)
+
+
 class InterestModel:
     """Competence history of each model, and the choice of the model to train."""
 
@@ -59,7 +77,6 @@ class InterestModel:
         # Only the model just attempted changes its progress: cached, so that choosing costs
         # no pass over the histories.
         self._progress = np.zeros(n_models)
-        self._full_window_positions: dict[int, np.ndarray] = {}
 
     @property
     def attempts(self) -> np.ndarray:
@@ -95,26 +112,10 @@ class InterestModel:
     def _model_progress(self, model: int) -> float:
         n = int(self._attempts[model])
         half = min(self.window, n // 2)
-        if half == 0:
-            return 0.0
-        # The last 2 * half attempts in the ring buffer, oldest first.
-        recent = self._competences[model, self._ring_positions(n, half)]
-        # ndarray.mean's own arithmetic (NumPy's sum, then the division), without its overhead.
-        newer = float(np.add.reduce(recent[half:])) / half
-        older = float(np.add.reduce(recent[:half])) / half
-        return abs(newer - older)
-
-    def _ring_positions(self, n: int, half: int) -> np.ndarray:
-        """Ring-buffer positions of attempts n - 2 half .. n - 1. With full windows (all but a
-        model's first 2 W attempts) they depend only on n mod 2 W: kept once made."""
-        ring = 2 * self.window
-        if half < self.window:
-            return np.arange(n - 2 * half, n) % ring
-        positions = self._full_window_positions.get(n % ring)
-        if positions is None:
-            positions = np.arange(n - ring, n) % ring
-            self._full_window_positions[n % ring] = positions
-        return positions
+        if half <= BLOCK:  # the compiled sums' reach (learner/pairwise_sum.py): the default W
+            return window_progress(self._competences[model], n, half)
+        recent = self._competences[model, np.arange(n - 2 * half, n) % (2 * self.window)]
+        return abs(float(recent[half:].mean()) - float(recent[:half].mean()))
 
     def state_dict(self) -> dict[str, np.ndarray]:
         return {"competences": self._competences.copy(), "attempts": self._attempts.copy()}
