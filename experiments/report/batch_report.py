@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from experiments import provenance
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
@@ -40,7 +41,9 @@ def write_report(
     out = Path(out_dir) if out_dir is not None else results.batch_dir
     check_out_dir(out)
     geometry, numbers, published, figures = numbers_and_figures(results, measures)
-    where, where_note = where_table(results)
+    # Where this page's statistics are computed: said on the page and in its summary.
+    computed_on = provenance.short_record(provenance.machine_record())
+    where, where_note = where_table(results, computed_on)
     page = render(
         "report.html.j2",
         title=f"Playroom batch report: {results.batch_dir.name}",
@@ -60,7 +63,12 @@ def write_report(
         **intro.page_context(results, geometry),
     )
     content = page_summary(
-        results, numbers, published, page=REPORT_FILE, batches=[str(results.batch_dir)]
+        results,
+        numbers,
+        published,
+        page=REPORT_FILE,
+        batches=[str(results.batch_dir)],
+        computed_on=computed_on,
     )
     return write_page(out, figures, REPORT_FILE, page, beside=summary_files(content))
 

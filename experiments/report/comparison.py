@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from experiments import provenance
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import (
     COMPETENCE_SCOPES,
@@ -276,7 +277,8 @@ def write_comparison(
     geometry, numbers, published, page_figures = numbers_and_figures(merged, measures)
     figures = [FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png) for f in page_figures]
     g = merged.groups
-    where, where_note = where_table(merged)
+    computed_on = provenance.short_record(provenance.machine_record())  # this page's machine
+    where, where_note = where_table(merged, computed_on)
     tests = Table(
         ["statistic", g[0], g[1], "test of the difference", "p (two-sided)"],
         difference_rows(a, b, geometry, measures, grasp_rate_commands),
@@ -308,6 +310,7 @@ def write_comparison(
         published,
         page=COMPARISON_FILE,
         batches=[str(d) for d in dict.fromkeys((dir_a, dir_b))],
+        computed_on=computed_on,
         tests=tests,
     )
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page, summary_files(content))

@@ -185,13 +185,13 @@ def _counts_text(rows: pd.DataFrame, groups: list[str]) -> str:
     return f"{n} ({', '.join(p for p in per if not p.endswith(' 0'))})"
 
 
-def where_table(results: BatchResults) -> tuple[Table, str]:
+def where_table(results: BatchResults, computed_on: dict[str, str] | None) -> tuple[Table, str]:
     """Where the trials ran: one row per machine and library set (CPU, NumPy's SIMD, BLAS
     kernel, numpy and mujoco versions, host, commit) with the trials computed and evaluated
     there; trials from before provenance was recorded count as "not recorded". Returns the
-    table and a sentence about trials computed on more than one machine."""
-    from experiments import provenance
-    from experiments.provenance import SHORT_FIELDS
+    table and a sentence about trials computed on more than one machine, and about
+    `computed_on`, the machine computing the page (provenance's short record)."""
+    from experiments.provenance import SHORT_FIELDS, describe
 
     where = results.provenance
     if "status" not in where:  # results built without it (none read from a batch)
@@ -216,12 +216,11 @@ def where_table(results: BatchResults) -> tuple[Table, str]:
         if moved
         else "Each trial was computed on one machine and library set."
     )
-    # The page's own statistics are computed here: the last digits of a bootstrap interval
-    # follow this machine's BLAS kernel (OpenBLAS's SkylakeX and Haswell kernels, measured).
-    this_machine = provenance.describe(provenance.short_record(provenance.machine_record()))
+    # The page's own statistics are computed on `computed_on`: a bootstrap interval's last digits
+    # follow its BLAS kernel (OpenBLAS's SkylakeX and Haswell kernels, measured).
     note += (
-        f" This page's statistics were computed on {this_machine}; the last digits of their "
-        "bootstrap intervals follow that machine's BLAS kernel."
+        f" This page's statistics were computed on {describe(computed_on)}; the last digits "
+        "of their bootstrap intervals follow that machine's BLAS kernel."
     )
     return Table(header, rows), note
 

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from experiments import provenance, storage
+from experiments import storage
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
 from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
@@ -115,6 +115,7 @@ def page_summary(
     published: dict[str, PaperNumber],
     page: str,
     batches: list[str],
+    computed_on: dict[str, str] | None,
     tests: Table | None = None,
 ) -> dict[str, Any]:
     """The summary of a page (module docstring), JSON-ready but for NaN and inf.
@@ -122,7 +123,7 @@ def page_summary(
     out: dict[str, Any] = {
         "page": page,
         "batches": batches,
-        "computed_on": provenance.short_record(provenance.machine_record()),
+        "computed_on": computed_on,
         "groups": list(results.groups),
         "by_group": {g: _group_numbers(results, numbers, g) for g in results.groups},
         "trials": _trial_records(results),
