@@ -68,6 +68,25 @@ def placements(
     return out
 
 
+# How a test touched the stick, and what moved its goal toy (`movement_contacts`): like with like
+# across backends, where the study's "tool" (the stick moved) means held in the kinematic one
+# and mostly pushed in the physical one (issue 32).
+STICK_CONTACTS = ("held", "pushed", "untouched")
+MOVERS = ("hand", "stick", "caregiver", "push", "none")
+
+
+def movement_contacts(events: list[ev.Event], toy: str) -> tuple[str, str]:
+    """(stick, goal_moved_by) of one test movement from its events: the stick "held" (the hand
+    took it), "pushed" (it moved without being taken) or "untouched"; the goal toy moved by the
+    "hand" (held), the "stick" (caught by its tip), the "caregiver" (brought), a "push" (by
+    anything it was not held by), or "none"."""
+    kinds = {e.kind for e in events}
+    stick_moved = any(e.kind == ev.STICK_MOVED for e in events)
+    stick = "held" if ev.STICK_GRASPED in kinds else "pushed" if stick_moved else "untouched"
+    movers = [e.by for e in events if e.kind == ev.TOY_MOVED and e.obj == toy]
+    return stick, str(movers[0]) if movers and movers[0] in MOVERS else "none"
+
+
 def strategy_of(motor_space: str, stick_moved: bool) -> str:
     """hand (arm, stick still), tool (arm, stick moved) or vocal (voice): docs/protocol.md §10."""
     if motor_space == "voice":
@@ -111,6 +130,9 @@ def competence_table(
                     stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
                     stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
                     error = float(np.linalg.norm(feedback.s[block] - goal))
+                    stick_contact, goal_moved_by = movement_contacts(
+                        feedback.events, f"toy{toy + 1}"
+                    )
                     room.set_state(scene)
                     random_space = "arm" if rng.random() < 0.5 else "voice"
                     dim = MOTOR_DIMS[random_space]
@@ -130,6 +152,8 @@ def competence_table(
                             "strategy": strategy_of(space, bool(stick_moved)),
                             # A tool test either held the stick or only pushed it.
                             "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
+                            "stick_contact": stick_contact,
+                            "goal_moved_by": goal_moved_by,
                             "untrained": untrained,
                             "error": error,
                             "random_error": random_error,

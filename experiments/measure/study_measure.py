@@ -48,7 +48,7 @@ from tqdm import tqdm
 import models
 import sim
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING, study_summary
-from experiments.measure.evaluation import goal_trajectory, strategy_of
+from experiments.measure.evaluation import goal_trajectory, strategy_of, movement_contacts
 from learner.agent import Agent
 from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
 from sim import Playroom
@@ -79,7 +79,8 @@ def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
 
 def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
     """One row per test: ring, toy, x, y (the toy's position), strategy, stick_dx (the stick's
-    x at the last sample minus at the first, m), error."""
+    x at the last sample minus at the first, m), error, stick_contact and goal_moved_by
+    (`movement_contacts`)."""
     rng = np.random.default_rng([settings.seed, room.seed])
     rows = []
     for ring_number, ring in enumerate(room.config.toy_rings, start=1):
@@ -101,7 +102,9 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
                     space, m = "voice", agent.exploit(voice, context, goal)
                 else:  # neither model has data: the arm at rest
                     space, m = "arm", np.zeros(MOTOR_DIMS["arm"])
-                s = room.act(space, m).s
+                feedback = room.act(space, m)
+                s = feedback.s
+                stick_contact, goal_moved_by = movement_contacts(feedback.events, toy)
                 stick_x = s[block_slice("stick")][:5]
                 rows.append(
                     {
@@ -114,6 +117,8 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
                         # sub-millimetre motions (experiments/analysis/stats.py, tool_motion).
                         "stick_dx": float(stick_x[-1] - stick_x[0]),
                         "error": float(np.linalg.norm(s[block_slice(toy)] - goal)),
+                        "stick_contact": stick_contact,
+                        "goal_moved_by": goal_moved_by,
                     }
                 )
     return pd.DataFrame(rows)

@@ -17,11 +17,13 @@ from experiments.measure.evaluation import (
     goal_trajectory,
     normalised_competence,
     strategy_of,
+    movement_contacts,
 )
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.trial_checks import load_trial
 from models.layout import ARM_DIM
 from sim import Playroom
+from sim import events as ev
 from sim.config import world_preset
 
 # The world these tests were written for: the project preset (explicit, as Playroom() takes
@@ -57,12 +59,32 @@ def test_strategy_classification():
     assert strategy_of("arm", stick_moved=True) == "tool"
 
 
+def test_contacts_tell_a_held_stick_from_a_pushed_one_and_name_what_moved_the_goal():
+    held = [ev.Event(ev.STICK_GRASPED, 3), ev.Event(ev.STICK_MOVED, 3, obj="stick", by="hand")]
+    pushed = [ev.Event(ev.STICK_MOVED, 7, obj="stick", by="push")]
+    caught = [*held, ev.Event(ev.TOY_MOVED, 20, obj="toy2", by="stick")]
+    brought = [ev.Event(ev.TOY_MOVED, 2, obj="toy3", by="caregiver")]
+    assert movement_contacts(held, "toy1") == ("held", "none")
+    assert movement_contacts(pushed, "toy1") == ("pushed", "none")
+    assert movement_contacts(caught, "toy2") == ("held", "stick")
+    assert movement_contacts(caught, "toy1") == ("held", "none")  # another toy's mover
+    assert movement_contacts(brought, "toy3") == ("untouched", "caregiver")
+    assert movement_contacts([ev.Event(ev.TOY_MOVED, 9, obj="toy1", by="push")], "toy1") == (
+        "untouched",
+        "push",
+    )
+    assert movement_contacts([], "toy1") == ("untouched", "none")
+
+
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
 def test_scripted_agent_errors_match_a_hand_computation(grasp):
     room = Playroom(grasp, seed=0, config=PROJECT)
     table = competence_table(RestingAgent(), room, EvaluationSettings(n_placements=4, seed=9))
     assert len(table) == 3 * 4 * 3
     assert set(table["strategy"]) == {"hand"}
+    # The resting arm holds no stick and moves a toy only where it grabs one at once.
+    assert set(table["stick_contact"]) == {"untouched"}
+    assert set(table["goal_moved_by"]) <= {"none", "hand"}
     # A toy at p that does not move, against the goal p (1 - t): error = |p| sqrt(sum t^2),
     # unless the resting hand (at (0, 0.5)) grabs it at once.
     far_from_hand = np.hypot(table["x"], table["y"] - 0.5) > 0.15
