@@ -138,6 +138,7 @@ def competence_table(
                     dim = MOTOR_DIMS[random_space]
                     random_fb = room.act(random_space, rng.uniform(-1, 1, dim))
                     random_error = float(np.linalg.norm(random_fb.s[block] - goal))
+                    _, random_moved_by = movement_contacts(random_fb.events, f"toy{toy + 1}")
                     room.set_state(scene)
                     rows.append(
                         {
@@ -157,6 +158,8 @@ def competence_table(
                             "untrained": untrained,
                             "error": error,
                             "random_error": random_error,
+                            # what the random command in the same scene did to the goal toy
+                            "random_goal_moved_by": random_moved_by,
                         }
                     )
                     bar.update(1)

@@ -85,6 +85,7 @@ def test_scripted_agent_errors_match_a_hand_computation(grasp):
     # The resting arm holds no stick and moves a toy only where it grabs one at once.
     assert set(table["stick_contact"]) == {"untouched"}
     assert set(table["goal_moved_by"]) <= {"none", "hand"}
+    assert set(table["random_goal_moved_by"]) <= {"none", "hand", "stick", "caregiver", "push"}
     # A toy at p that does not move, against the goal p (1 - t): error = |p| sqrt(sum t^2),
     # unless the resting hand (at (0, 0.5)) grabs it at once.
     far_from_hand = np.hypot(table["x"], table["y"] - 0.5) > 0.15
