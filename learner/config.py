@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from models import layout
-from models.checks import check_bool, check_choice, check_int, check_number
+from models.checks import INT64_MAX, check_bool, check_choice, check_int, check_number
 from models.presets import PRESETS
 
 BABBLING_MODES = ("random", "active")
@@ -23,6 +23,20 @@ IMITATION_DRAWS = ("distinct", "heard")
 IMITATION_POOLS = ("recent", "all_heard")
 BOOTSTRAPS = ("shuffled_learned", "coin_not_learned")
 STORING_RULES = ("moved_from_start", "varies_about_mean")
+
+# The bounds of the settings (the module docstring gives the units).
+# The world takes commands in [-1, 1] (models/world.py): the motor bounds lie within.
+MOTOR_LIMIT = 1
+# Sensory values: positions on a table whose points lie within 1.84 m of the arm's base
+# (models/playroom.xml, 2.6 m square) and sounds within [-1, 1]. Goals lie within twice the
+# normalised range, and a change is at most the width of that, 4.
+SENSORY_LIMIT = 2
+# Histories the learner holds in memory and writes into every checkpoint: the progress window
+# keeps 2 W float64 per model (160 MB for the 10 models at a million), the imitation memory 10
+# float64 per sound (80 MB at a million); both far beyond a trial's attempts at the study's
+# length. The bootstrap's order is a byte per command (10 MB at ten million of each).
+HISTORY_MAX = 1_000_000
+BOOTSTRAP_MAX = 10_000_000
 
 
 @dataclass(frozen=True)
@@ -79,20 +93,27 @@ class LearnerConfig:
         """Every field checked when the config is built (ValueError, one line naming the
         field and what it allows): JSON types are not coerced, numbers must be finite."""
         c = "LearnerConfig."
-        for name in ("progress_window", "imitation_memory", "outcomes_to_infer"):
-            check_int(c + name, getattr(self, name), minimum=1)
+        for name in ("progress_window", "imitation_memory"):
+            check_int(c + name, getattr(self, name), 1, HISTORY_MAX)
+        # A count of stored outcomes, compared with a model's rows: an int64 holds any.
+        check_int(c + "outcomes_to_infer", self.outcomes_to_infer, 1, INT64_MAX)
         for name in ("bootstrap_arm", "bootstrap_voice"):
-            check_int(c + name, getattr(self, name), minimum=0)
-        for low, high in (("motor_low", "motor_high"), ("goal_low", "goal_high")):
-            check_number(c + low, getattr(self, low))
-            check_number(c + high, getattr(self, high))
+            check_int(c + name, getattr(self, name), 0, BOOTSTRAP_MAX)
+        for low, high, limit in (
+            ("motor_low", "motor_high", MOTOR_LIMIT),
+            ("goal_low", "goal_high", SENSORY_LIMIT),
+        ):
+            check_number(c + low, getattr(self, low), f"[-{limit}, {limit}]")
+            check_number(c + high, getattr(self, high), f"[-{limit}, {limit}]")
             if not getattr(self, low) < getattr(self, high):
                 raise ValueError(
                     f"{c}{low} must be below {c}{high}, got {getattr(self, low)!r} >= "
                     f"{getattr(self, high)!r}"
                 )
-        for name in ("exploration_sigma", "change_tolerance"):
-            check_number(c + name, getattr(self, name), "[0, inf)")
+        # Noise beyond the width of the motor range is no longer exploration around a command.
+        motor_range = self.motor_high - self.motor_low
+        check_number(c + "exploration_sigma", self.exploration_sigma, f"[0, {motor_range!r}]")
+        check_number(c + "change_tolerance", self.change_tolerance, f"[0, {2 * SENSORY_LIMIT}]")
         for name in ("active_random_share", "imitation_share"):
             check_number(c + name, getattr(self, name), "[0, 1]")
         for name, choices in (

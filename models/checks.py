@@ -63,10 +63,19 @@ def check_numbers(name: str, value: Any, length: int, interval: str = "(-inf, in
         )
 
 
-def check_int(name: str, value: Any, minimum: int = 1) -> None:
-    """`value` is an integer (not a bool, not a float) >= `minimum`."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {_got(value)}")
+# The largest integer an int64 holds: a trial's logs and checkpoints keep their integers
+# (iterations, counts) in int64, so no period or count of a trial can need more.
+INT64_MAX = 2**63 - 1
+
+
+def check_int(name: str, value: Any, minimum: int = 1, maximum: int | None = None) -> None:
+    """`value` is an integer (not a bool, not a float) >= `minimum` and, given one, <= `maximum`
+    (a size that must fit memory, a count that must fit an int64)."""
+    integer = not isinstance(value, bool) and isinstance(value, numbers.Integral)
+    if not (integer and value >= minimum and (maximum is None or value <= maximum)):
+        shown = "2**63 - 1" if maximum == INT64_MAX else str(maximum)
+        allowed = f">= {minimum}" if maximum is None else f"in [{minimum}, {shown}]"
+        raise ValueError(f"{name} must be an integer {allowed}, got {_got(value)}")
 
 
 def check_choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
@@ -88,3 +97,18 @@ def tuples(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return tuple(tuples(v) for v in value)
     return value
+
+
+# The largest seed of a trial or batch: every log row records its seed in an int64 Parquet
+# column (experiments/analysis/logs.py), which holds no more. NumPy's generators take any
+# non-negative integer, and nothing derives a seed from a trial's (seed * K + i), so the
+# column is the only bound; seeds up to it ran, were evaluated and reported (issue 31).
+MAX_SEED = 2**63 - 1
+
+
+def check_seed(name: str, value: Any) -> None:
+    """`value` is an integer seed (not a bool, not a float) in [0, MAX_SEED]."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be an integer in [0, 2**63 - 1], got {_got(value)}")
+    if not 0 <= int(value) <= MAX_SEED:
+        raise ValueError(f"{name} must be an integer in [0, 2**63 - 1], got {_got(value)}")

@@ -1,18 +1,30 @@
 """Shared test setup.
 
-MuJoCo picks its OpenGL backend when `mujoco` is first imported, and the video tests render
-offscreen in this process: choose EGL here, before any test module imports mujoco (the
-`playroom` command does the same per command, experiments/video/gl.py).
+No OpenGL backend is chosen for the suite: most tests never render, and they run with the
+user's `MUJOCO_GL`, unset on most machines, as non-rendering commands do. The tests that render
+in this process choose their backend themselves (tests/video/conftest.py), those that run
+`playroom render` in a subprocess leave it to the command (experiments/video/gl.py).
 """
 
 import os
 
-os.environ.setdefault("MUJOCO_GL", "egl")
-
-import pytest  # noqa: E402
+import pytest
 
 # A generated DIVA map installed for a test (the real one is the user's): used across stages.
-from diva_files import installed_generated_map  # noqa: E402, F401
+from diva_files import installed_generated_map  # noqa: F401
+
+
+@pytest.fixture(autouse=True)
+def gl_choice_kept():
+    """A command run in this process (`main([...])`) chooses MUJOCO_GL for the process, as
+    `playroom` does for its own (experiments/video/gl.py): put it back after each test, so that
+    one test's choice never reaches the next one's subprocesses."""
+    before = os.environ.get("MUJOCO_GL")
+    yield
+    if before is None:
+        os.environ.pop("MUJOCO_GL", None)
+    else:
+        os.environ["MUJOCO_GL"] = before
 
 
 @pytest.fixture(scope="session", autouse=True)

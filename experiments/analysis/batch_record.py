@@ -1,15 +1,18 @@
 """What a batch directory records of the batch that wrote it (batch.json, written by
-`playroom batch`): here, the size of the study's random reference its reports play, which the
-batch's profile sets (experiments/batches/profiles/*.json, "study_reference_commands")."""
+`playroom batch`): the size of the study's random reference its reports play, which the
+batch's profile sets (experiments/batches/profiles/*.json, "study_reference_commands"), and
+the settings its trials must have been run with, which its reports check."""
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Iterable
 from pathlib import Path
 
 from experiments import storage
-from experiments.file_names import BATCH_FILE
+from experiments.config_file import with_added_settings
+from experiments.file_names import BATCH_FILE, CONFIG_FILE, EVAL_FILE
 
 
 def recorded_reference_commands(batch_dirs: Iterable[str | os.PathLike]) -> int | None:
@@ -27,3 +30,70 @@ def recorded_reference_commands(batch_dirs: Iterable[str | os.PathLike]) -> int 
         if isinstance(size, int) and not isinstance(size, bool) and size > 0:
             sizes.append(size)
     return max(sizes, default=None)
+
+
+class RecordMismatch(ValueError):
+    """Trials of a batch directory that its record says another batch than they ran."""
+
+
+# The trial settings a record fixes for every trial (a record field -> config.json's "trial").
+_SAME = ("iterations", "stick_return", "preset", "voice", "overrides")
+# The record's lists: each trial's setting is one of them.
+_ONE_OF = {"grasps": "grasp", "babbling": "babbling", "seeds": "seed"}
+
+
+def _disagreement(record: dict, trial: dict, n_placements: object) -> str | None:
+    """How a trial's settings (config.json's "trial", older settings added) differ from what
+    the record runs, the first difference in words; None when none does."""
+    for name, setting in _ONE_OF.items():
+        allowed = record.get(name)
+        if isinstance(allowed, list) and trial.get(setting) not in allowed:
+            return f"{setting} {trial.get(setting)!r}, which the record's {name} do not hold"
+    expected = {name: record[name] for name in _SAME if name in record}
+    if "checkpoint_every" in record and "iterations" in record:  # a trial checkpoints at its end
+        expected["checkpoint_every"] = min(record["checkpoint_every"], record["iterations"])
+    for name, value in expected.items():
+        if trial.get(name) != value:
+            return f"{name}={_shown(trial.get(name))} where the record says {_shown(value)}"
+    placements = record.get("eval_placements")
+    if placements is not None and n_placements is not None and n_placements != placements:
+        return f"eval_placements={n_placements} where the record says {placements}"
+    return None
+
+
+def _shown(value: object) -> str:
+    text = value if isinstance(value, str) else json.dumps(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path]) -> None:
+    """RecordMismatch (one line) naming the trials of `batch_dir` whose config.json (or
+    evaluation) disagrees with the batch's record (batch.json): a batch rerun into the same
+    directory with other settings, before `playroom batch` refused it, left such a mix. A
+    batch without a readable record is not checked (one written before batch.json)."""
+    path = Path(batch_dir) / BATCH_FILE
+    try:
+        record = storage.read_json(path) if path.is_file() else None
+    except (storage.CorruptFileError, OSError):
+        record = None  # as for the reference size: a damaged record is no record
+    if not isinstance(record, dict):
+        return
+    found = []
+    for trial_dir in trial_dirs:
+        try:
+            config = storage.read_json(trial_dir / CONFIG_FILE)
+            summary = storage.read_json(trial_dir / EVAL_FILE)
+        except (storage.CorruptFileError, OSError):
+            continue  # the reader that needs the file says what is wrong with it
+        trial = with_added_settings(config).get("trial") if isinstance(config, dict) else None
+        placements = summary.get("n_placements") if isinstance(summary, dict) else None
+        why = _disagreement(record, trial, placements) if isinstance(trial, dict) else None
+        if why is not None:
+            found.append((trial_dir.name, why))
+    if found:
+        (name, why), more = found[0], len(found) - 1
+        others = f" (and {more} more trial(s))" if more else ""
+        raise RecordMismatch(
+            f"{name} in {batch_dir} ran with {why} ({path.name}){others}: the directory mixes "
+            "two batches' trials; report each batch from a directory of its own"
+        )

@@ -5,15 +5,25 @@ Each kind of log has its own folder, one chunk per checkpoint period:
 before the kinds had folders hold `log/iterations-NNNNNNNN.parquet` and
 `log/words-NNNNNNNN.parquet` side by side; both layouts are read here (a resume moves the old
 chunks into the folders: experiments/run/trial_checks.py, `move_old_chunks`). Read-only.
+
+Each chunk carries its trial's identity in its Parquet schema's metadata, as each checkpoint
+does in its own (`trial_identity`: the seed and a hash of the settings that make the trial), so
+that a chunk copied from another trial is told apart (`check_chunk`). It is written as the
+table's `attrs[CHUNK_IDENTITY_KEY]`, which pandas keeps there (JSON under b"PANDAS_ATTRS") and
+gives back to a reader of the chunk. Chunks written before they carried one are taken as their
+trial's, as they always were.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
 from pathlib import Path
 
 from experiments import storage
+from experiments.config_file import identity_form
 from experiments.file_names import (
     CONFIG_FILE,
     LOG_CHUNK_PREFIX,
@@ -27,8 +37,73 @@ _CHUNK = re.compile(re.escape(LOG_CHUNK_PREFIX) + r"(?P<start>[0-9]{8})\.parquet
 _OLD_CHUNK = re.compile(OLD_LOG_CHUNK_PATTERN)
 
 
+# The key of a chunk's table attrs that holds its trial's identity, and where pandas keeps a
+# table's attrs in the Parquet schema's metadata (DataFrame.to_parquet, read_parquet).
+CHUNK_IDENTITY_KEY = "playroom.trial"
+_PANDAS_ATTRS = b"PANDAS_ATTRS"
+# Settings a resume may change: a trial can be extended to more iterations.
+EXTENSIBLE = ("trial.iterations",)
+# What an identity leaves out of its trial's config: the settings a resume may change, and the
+# package version. The version says which code wrote config.json, not which trial it is; in the
+# identity it would orphan every checkpoint at each release (whether a trial may be resumed by
+# another version is for the config comparison on resume to say).
+_NOT_IDENTITY = (*EXTENSIBLE, "package_version")
+
+
 class DuplicateChunkError(storage.CorruptFileError):
     """A chunk found in both layouts: which one is the trial's cannot be told."""
+
+
+class ForeignChunkError(storage.CorruptFileError):
+    """A chunk that carries another trial's identity than the trial it lies in."""
+
+
+def trial_identity(config: dict) -> dict:
+    """What a trial's checkpoints and log chunks carry of it: the seed, and a hash of the
+    trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
+    kept = identity_form(config)  # a copy, as older trials' configs would read
+    for key in _NOT_IDENTITY:
+        *parents, last = key.split(".")
+        node = kept
+        for parent in parents:
+            node = node.get(parent, {})
+        node.pop(last, None)
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    return {"seed": config["trial"]["seed"], "config": digest}
+
+
+def identity_text(identity: object) -> str:
+    """An identity as messages show it: "seed 5, config 0123456789ab"."""
+    found = identity if isinstance(identity, dict) else {}
+    return f"seed {found.get('seed', '?')}, config {found.get('config', '?')}"
+
+
+def chunk_identity(path: Path) -> object:
+    """The identity a chunk carries (as written: a dict, unless someone wrote another thing),
+    or None for a chunk written before chunks carried one. CorruptFileError if unreadable."""
+    import pyarrow.parquet as pq  # imported where used, as experiments/storage.py does
+
+    try:
+        metadata = pq.read_schema(path).metadata or {}
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise storage.CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+    try:
+        attrs = json.loads(metadata.get(_PANDAS_ATTRS, b"{}"))
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        return "unreadable"  # not the trial's own writing: never taken as its identity
+    return attrs.get(CHUNK_IDENTITY_KEY) if isinstance(attrs, dict) else "unreadable"
+
+
+def check_chunk(path: Path, own: dict, trial_dir: str | os.PathLike) -> None:
+    """ForeignChunkError (one line, naming the chunk and both identities) if the chunk at
+    `path` carries another identity than `own`, its trial's; a chunk without one passes."""
+    found = chunk_identity(path)
+    if found is not None and found != own:
+        raise ForeignChunkError(
+            f"{path} belongs to another trial ({identity_text(found)}) than {trial_dir} "
+            f"({identity_text(own)}); refusing to mix them"
+        )
 
 
 def check_kind(kind: str) -> None:

@@ -5,7 +5,9 @@
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
 Every row carries its source: `trial` (the trial directory's name), `seed`, `backend` (the
-grasp backend) and `voice` (the vocal tract), so that rows of several trials keep apart.
+grasp backend) and `voice` (the vocal tract), so that rows of several trials keep apart; every
+chunk its trial's identity, so that a chunk copied from another trial is refused
+(experiments/analysis/log_chunks.py).
 Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
 `pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks'
 names, which is the iterations' order).
@@ -40,7 +42,15 @@ from pathlib import Path
 import pandas as pd
 
 from experiments import storage
-from experiments.analysis.log_chunks import check_kind, chunk_paths, is_trial_dir
+from experiments.analysis.finished import unfinished_trials, warn_unfinished
+from experiments.analysis.log_chunks import (
+    check_chunk,
+    check_kind,
+    chunk_identity,
+    chunk_paths,
+    is_trial_dir,
+    trial_identity,
+)
 from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 
@@ -66,21 +76,41 @@ def read_log(
     source columns (filled from config.json for logs written before rows carried them). An
     empty DataFrame if the trial has no chunk of that kind yet. storage.CorruptFileError for a
     chunk that cannot be read. `columns`: only those (of them, the ones the log has) beside the
-    source columns; a log's 47 columns take twice as long to read as the report's 10."""
+    source columns; a log's 47 columns take twice as long to read as the report's 10.
+    A chunk that carries another trial's identity than config.json's (or, without one, than
+    the other chunks') is a storage.CorruptFileError too, naming it and both identities."""
     check_kind(kind)
     chunks = chunk_paths(trial_dir, kind)
     if not chunks:
         return pd.DataFrame()
-    wanted = None if columns is None else [*SOURCE_COLUMNS, *columns]
-    frame = pd.concat([storage.read_table(c, wanted) for c in chunks.values()], ignore_index=True)
-    missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
     config_path = Path(trial_dir) / CONFIG_FILE
-    if missing and config_path.exists():
-        source = source_of(trial_dir, with_added_settings(storage.read_json(config_path)))
+    config = with_added_settings(storage.read_json(config_path)) if config_path.exists() else None
+    own = _identity_of(config)
+    wanted = None if columns is None else [*SOURCE_COLUMNS, *columns]
+    frames = []
+    for chunk in chunks.values():
+        if own is None:  # without a config.json, the first chunk's identity is the trial's
+            found = chunk_identity(chunk)
+            own = found if isinstance(found, dict) else None
+        if own is not None:
+            check_chunk(chunk, own, trial_dir)
+        frames.append(storage.read_table(chunk, wanted))
+    frame = pd.concat(frames, ignore_index=True)
+    missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
+    if missing and config is not None:
+        source = source_of(trial_dir, config)
         for position, column in enumerate(SOURCE_COLUMNS):
             if column in missing:
                 frame.insert(position, column, source[column])
     return frame
+
+
+def _identity_of(config: dict | None) -> dict | None:
+    """The identity of the trial of a config.json, None without one that names a seed."""
+    try:
+        return None if config is None else trial_identity(config)
+    except (KeyError, TypeError):  # edited by hand: the rows say what they are
+        return None
 
 
 def trial_dirs(batch_dir: str | os.PathLike) -> list[Path]:
@@ -91,10 +121,15 @@ def trial_dirs(batch_dir: str | os.PathLike) -> list[Path]:
     return sorted(d for d in batch_dir.iterdir() if d.is_dir() and is_trial_dir(d))
 
 
-def read_batch_logs(batch_dir: str | os.PathLike, kind: str = "iterations") -> pd.DataFrame:
+def read_batch_logs(
+    batch_dir: str | os.PathLike, kind: str = "iterations", *, include_incomplete: bool = False
+) -> pd.DataFrame:
     """One log ('iterations' or 'words') of every trial of a batch directory in one DataFrame,
     trial after trial (by directory name), each row with its source columns (trial, seed,
-    backend, voice). ValueError (one line) for a folder that holds no trial directory."""
+    backend, voice). ValueError (one line) for a folder that holds no trial directory.
+    Trials that have not run to their end (a batch still running) are named in an
+    `IncompleteTrialsWarning` and left out unless `include_incomplete`
+    (experiments/analysis/finished.py)."""
     check_kind(kind)
     dirs = trial_dirs(batch_dir)
     if not dirs:
@@ -102,5 +137,9 @@ def read_batch_logs(batch_dir: str | os.PathLike, kind: str = "iterations") -> p
             f"no trial directories in {batch_dir}: a batch directory holds one folder per trial "
             "(its config.json and log/), as `playroom batch --out DIR` writes them"
         )
+    incomplete = unfinished_trials(dirs)
+    if incomplete:
+        warn_unfinished(batch_dir, incomplete, kept=include_incomplete)
+        dirs = dirs if include_incomplete else [d for d in dirs if d not in incomplete]
     frames = [frame for frame in (read_log(d, kind) for d in dirs) if not frame.empty]
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()

@@ -22,9 +22,12 @@ from typing import Any
 import pandas as pd
 
 from experiments import storage
+from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
 from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.log_chunks import is_trial_dir
 from experiments.analysis.logs import read_log
+from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
+from experiments.analysis.mechanisms import trial_mechanisms
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     COMPETENCE_FILE,
@@ -227,7 +230,8 @@ def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     try:
         # Only what the report reads of the iterations log (its curves, stick numbers and
         # divergences): half the time of reading all of it.
-        log = read_log(trial_dir, columns=(*LOG_COLUMNS, "diverged"))
+        columns = dict.fromkeys((*LOG_COLUMNS, *MECHANISM_COLUMNS, "diverged"))
+        log = read_log(trial_dir, columns=tuple(columns))
         words = read_log(trial_dir, "words")
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
@@ -306,6 +310,7 @@ def _trial_rows(
         **_eval_numbers(d, summary),
         "diverged": int(log["diverged"].sum()),
         **tool_numbers(log, reach),
+        **trial_mechanisms(log, names, set(voc["word"])),
         "seconds": seconds,
         "timed_iterations": timed,
     }
@@ -319,6 +324,10 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
     directory without trials, trials not evaluated, or mismatched configs within a group."""
     batch_dir = Path(batch_dir)
     dirs = _trial_dirs(batch_dir)
+    try:  # trials of another batch than batch.json records: never drawn under its name
+        check_trials_agree(batch_dir, dirs)
+    except RecordMismatch as exc:
+        raise ReportError(str(exc)) from None
     configs = [_read_json(d / CONFIG_FILE) for d in dirs]
     configs = [with_added_settings(c) if isinstance(c, dict) else c for c in configs]
     evals = [_read_json(d / EVAL_FILE) for d in dirs]

@@ -16,7 +16,6 @@ import hashlib
 import json
 import logging
 import os
-import sys
 import threading
 import time
 import uuid
@@ -28,6 +27,7 @@ from tqdm import tqdm
 
 from experiments import storage
 from experiments.batches import scheduler as dask_scheduler
+from experiments.batches.directory import check_directory
 from experiments.batches.progress import (
     REPORT_EVERY,
     REPORT_INTERVAL_S,
@@ -51,12 +51,35 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.run.trial_checks import check_logs
 from experiments.run.trial_files import TrialError, check_identity
+from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 
 # How long a batch task waits for another writer of its trial to finish (s): longer than a
 # trial of the paper profile takes on one core.
 LOCK_WAIT_S = 4 * 3600
 # How often a batch waiting for its trials looks for a stop request Python dropped (s).
 STOP_POLL_S = 0.2
+# How often Dask runs a task again that raised: for faults of a worker or machine that may pass
+# (a full disk freed, a file system back). A lost worker is rescheduled apart from these.
+RETRIES = 2
+# Failures that running the trial again would only repeat: a damaged or foreign trial
+# directory, settings its files refuse, another writer past the wait, the user's DIVA data
+# missing. A task returns them (`TrialFailed`) instead of raising, so that Dask neither retries
+# them nor logs its "Compute Failed" traceback, three times, before the batch's one line.
+DETERMINISTIC = (
+    TrialError,
+    storage.CorruptFileError,
+    DirectoryLocked,
+    DivaDataError,
+    DivaDataMissing,
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class TrialFailed:
+    """What a batch task returns for a failure of its trial that a retry would repeat: the
+    error's type and message, on one line."""
+
+    error: str
 
 
 def is_complete(trial_dir: Path) -> bool:
@@ -86,12 +109,30 @@ def run_and_evaluate(
     progress_topic: str | None = None,
     report_every: int = REPORT_EVERY,
     report_interval_s: float = REPORT_INTERVAL_S,
-) -> dict:
-    """One batch task: run or resume the trial, then evaluate it. Safe to run again. A wait
+) -> dict | TrialFailed:
+    """One batch task: run or resume the trial, then evaluate it; its evaluation summary, or
+    `TrialFailed` for a failure a retry would repeat (DETERMINISTIC). Safe to run again. A wait
     for another writer of the trial is told to the client listening on `topic`, the iteration
     the trial reached (looked at every `report_every`, told at most every
     `report_interval_s`) to the one listening on `progress_topic`."""
-    path = Path(trial_dir)
+    try:
+        return _run_and_evaluate(
+            Path(trial_dir), settings, eval_placements, topic, progress_topic, report_every,
+            report_interval_s,
+        )  # fmt: skip
+    except DETERMINISTIC as exc:
+        return TrialFailed(f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+
+
+def _run_and_evaluate(
+    path: Path,
+    settings: TrialSettings,
+    eval_placements: int,
+    topic: str | None,
+    progress_topic: str | None,
+    report_every: int,
+    report_interval_s: float,
+) -> dict:
     # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
     # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
     # the batch's last line. A worker draws no bar; a thread lock is enough.
@@ -165,6 +206,10 @@ def run_batch(
     out = Path(os.path.abspath(Path(out_dir).expanduser()))
     if out.exists() and not out.is_dir():
         raise BatchError(f"{out} is a file, not a directory")
+    try:
+        check_directory(spec, out)  # one batch per directory, refused before anything is written
+    except OSError as exc:
+        raise BatchError(f"cannot read {out}: {storage.reason(exc)}") from None
     todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
     skipped = len(spec.trials()) - len(todo)
     if not todo:
@@ -180,7 +225,7 @@ def run_batch(
             raise BatchError(str(exc)) from None
     shown = BatchProgress({n: s.iterations for n, s in todo}, enabled=progress)
     if notify is None:
-        notify = lambda line: tqdm.write(f"batch: {line}", file=sys.stderr)  # noqa: E731
+        notify = lambda line: shown.say(f"batch: {line}")  # noqa: E731
     run = uuid.uuid4().hex[:8]
     topic = f"playroom-batch-{run}"
     progress_topic = f"{topic}-progress"
@@ -196,7 +241,7 @@ def run_batch(
         # Where to watch the cluster (tasks, workers, memory), whichever cluster it is.
         link = dashboard_link(client)
         where = link or "none (the scheduler serves none)"
-        tqdm.write(f"batch: Dask dashboard: {where}", file=sys.stderr)
+        shown.say(f"batch: Dask dashboard: {where}")
         dask_scheduler.listen(client, topic, notify)
         shown.listen(client, progress_topic)
         listening = True
@@ -207,20 +252,25 @@ def run_batch(
             future = client.submit(
                 run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
                 progress_topic, report_every, report_interval_s, key=key, pure=False,
-                retries=2,
+                retries=RETRIES,
             )  # fmt: skip
             futures[future] = name
         if skipped and progress:
-            tqdm.write(f"skipping {skipped} complete trial(s)", file=sys.stderr)
+            shown.say(f"skipping {skipped} complete trial(s)")
         for future in _as_finished(futures):
             name = futures[future]
             try:
-                results[name] = future.result()
+                result = future.result()
             except Exception as exc:  # a trial's error must not stop the others
                 # Only a lost scheduler cancels a batch's tasks: its keys are its own.
                 if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
                     raise _lost(scheduler, todo, results) from None
                 failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+            else:
+                if isinstance(result, TrialFailed):
+                    failures[name] = result.error
+                else:
+                    results[name] = result
             shown.ended(name, failed=name in failures)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (experiments/cli/faults.py)
         # The workers' complaints about being closed mid-trial would follow the command's one
@@ -228,13 +278,15 @@ def run_batch(
         logging.getLogger("distributed").setLevel(logging.CRITICAL)
         raise
     finally:
-        shown.close()
-        if own_cluster is not None:
-            client.close()
-            own_cluster.close()
-        elif listening and not dask_scheduler.scheduler_lost(client):
-            client.unsubscribe_topic(topic)
-            client.unsubscribe_topic(progress_topic)
+        try:
+            shown.close()  # waits for stderr: a second Ctrl-C there still closes the cluster
+        finally:
+            if own_cluster is not None:
+                client.close()
+                own_cluster.close()
+            elif listening and not dask_scheduler.scheduler_lost(client):
+                client.unsubscribe_topic(topic)
+                client.unsubscribe_topic(progress_topic)
     if failures:
         listed = "; ".join(f"{n} ({e})" for n, e in sorted(failures.items()))
         raise BatchError(f"{len(failures)} trial(s) failed: {listed}")

@@ -18,6 +18,7 @@ from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig
+from models.checks import MAX_SEED
 from models.presets import DEFAULT_PRESET, PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS, WorldConfig
@@ -28,11 +29,21 @@ class BatchError(Exception):
     """A batch that cannot run as asked; the message says why."""
 
 
+# The most seeds a count ("seeds": N, seeds 0..N-1) may ask for: each seed is a trial directory
+# and a Dask task the scheduler holds from the start (the paper's profile has 500 seeds per
+# backend); a count far beyond this is a typo, and a count of 10**23 would be built as a tuple
+# before anything else is checked. A list of seeds is as long as its file.
+MAX_SEED_COUNT = 100_000
+
+
 # Fields of a batch config and of `BatchSpec`, with what each may hold (for the messages).
 FIELD_RULES = {
     "grasps": f"a non-empty list of distinct values from {', '.join(GRASPS)}",
     "babbling": f"a non-empty list of distinct values from {', '.join(BABBLING_MODES)}",
-    "seeds": "a positive count (seeds 0..N-1) or a non-empty list of distinct integers >= 0",
+    "seeds": (
+        f"a positive count (seeds 0..N-1) up to {MAX_SEED_COUNT} or a non-empty list of distinct "
+        "integers in [0, 2**63 - 1]"
+    ),
     "iterations": "a positive integer",
     "checkpoint_every": "a positive integer",
     "eval_placements": "a positive integer (placements per ring)",
@@ -89,7 +100,8 @@ class BatchSpec:
                 raise _field_error(name, values)
         if not isinstance(self.seeds, tuple) or not self.seeds:
             raise _field_error("seeds", self.seeds)
-        if not all(_is_int(s) and s >= 0 for s in self.seeds):
+        # Every log row records its seed in an int64 column (models/checks.py MAX_SEED).
+        if not all(_is_int(s) and 0 <= s <= MAX_SEED for s in self.seeds):
             raise _field_error("seeds", self.seeds)
         twice = sorted(s for s, n in Counter(self.seeds).items() if n > 1)
         if twice:
@@ -227,7 +239,7 @@ def load_spec(
             given[name] = tuple(given[name])
     seeds = given.get("seeds")
     if _is_int(seeds):
-        if seeds <= 0:
+        if not 0 < seeds <= MAX_SEED_COUNT:
             raise BatchError(f"{source}: {_field_error('seeds', seeds)}")
         given["seeds"] = tuple(range(seeds))
     try:

@@ -87,7 +87,10 @@ def cmd_eval(args: argparse.Namespace) -> None:
 
     try:
         summary = evaluate_trial(
-            args.dir, EvaluationSettings(n_placements=args.placements), progress=not args.quiet
+            args.dir,
+            EvaluationSettings(n_placements=args.placements),
+            progress=not args.quiet,
+            notify=lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True),
         )
     except (TrialError, storage.CorruptFileError) as exc:
         raise UsageError(str(exc)) from None
@@ -303,12 +306,16 @@ def _grasp_rate_commands(args: argparse.Namespace) -> dict:
 def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
     """The room measures a report shows (measured here, by the measuring stage: a report
     builds no room), with the reference size asked for, else the one the batches record (their
-    profile's), else the study's (experiments.analysis.study_summary)."""
+    profile's), else the study's (experiments.analysis.study_summary), played on the processes
+    asked for (--workers), else on every core."""
     from experiments.analysis.batch_record import recorded_reference_commands
     from experiments.measure.for_reports import room_measures
 
     n = args.study_reference_commands or recorded_reference_commands(batch_dirs)
-    return {"measures": room_measures() if n is None else room_measures(n)}
+    workers = getattr(args, "workers", None)  # None: the machine's cores
+    if n is None:
+        return {"measures": room_measures(workers=workers)}
+    return {"measures": room_measures(n, workers=workers)}
 
 
 def cmd_voice_data(args: argparse.Namespace) -> None:

@@ -53,6 +53,13 @@ def _study_reference_option(p: argparse.ArgumentParser) -> None:
         "study_reference_commands, which its profile sets: the study's 30000, 10000 placements "
         "x 3 toys, at the study's scale, fewer for smoke and demo)",
     )
+    p.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="processes playing the study's random reference when it is not kept yet "
+        "(default: cores; the numbers do not depend on it)",
+    )
 
 
 def _set_option(p: argparse.ArgumentParser, what: str) -> None:
@@ -334,7 +341,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.command not in RENDERING_COMMANDS:
         from experiments.video import gl
 
-        gl.without_rendering()
+        try:
+            gl.without_rendering()
+        except gl.GLError as exc:  # the user's MUJOCO_GL names a library that cannot load
+            print(f"playroom {args.command}: error: {exc}", file=sys.stderr)
+            return 2
     return run_command(args, sys.argv[1:] if argv is None else list(argv))
 
 

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from experiments.analysis.strategies import MOVERS
 from learner.agent import Agent
 from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
@@ -66,13 +67,6 @@ def placements(
                     break
             out[p, i] = xy
     return out
-
-
-# How a test touched the stick, and what moved its goal toy (`movement_contacts`): like with like
-# across backends, where the study's "tool" (the stick moved) means held in the kinematic one
-# and mostly pushed in the physical one (issue 32).
-STICK_CONTACTS = ("held", "pushed", "untouched")
-MOVERS = ("hand", "stick", "caregiver", "push", "none")
 
 
 def movement_contacts(events: list[ev.Event], toy: str) -> tuple[str, str]:

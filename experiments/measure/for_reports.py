@@ -10,10 +10,15 @@ from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import study_numbers
 
 
-def room_measures(study_reference_commands: int = RANDOM_COMMANDS_PER_RING) -> RoomMeasures:
+def room_measures(
+    study_reference_commands: int = RANDOM_COMMANDS_PER_RING, workers: int | None = None
+) -> RoomMeasures:
     """The study's numbers against a reference of `study_reference_commands` random commands
-    per ring (the study's 30000 by default), and the stick's grasp rates."""
+    per ring (the study's 30000 by default), played on `workers` processes (default: the
+    cores; the numbers are the same whatever their number), and the stick's grasp rates."""
     return RoomMeasures(
-        study_numbers=functools.partial(study_numbers, commands_per_ring=study_reference_commands),
+        study_numbers=functools.partial(
+            study_numbers, commands_per_ring=study_reference_commands, workers=workers
+        ),
         grasp_rates=grasp_rates,
     )

@@ -16,7 +16,9 @@ How the study's code measured (its scripts/run.py and analysis notebooks):
   pooled over runs the tests cover the whole disk; here from the trial's own seed;
 - random reference (notebook motor_babbling): per ring, 10000 placements, one random command
   (arm or voice, 1/2 each) per toy as goal, so 30000 commands, whose error was read on toy 1's
-  trajectory whatever the goal toy;
+  trajectory whatever the goal toy; here its commands are played in chunks of 1500, each from
+  a fresh room with its own seed, on every core (reference_pool.py): the scene carries over
+  within a chunk, not across chunks as in the notebook's one stream;
 - map (notebook analysis_competence): errors pooled over runs on a 100 x 100 grid over
   [-1, 1]^2 by the toy's position (pixel i holds x in [i/50 - 1, (i+1)/50 - 1)); the reference
   of a pixel at pixel-distance d from pixel (50, 50) is the unweighted mean of the per-pixel
@@ -43,12 +45,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from tqdm import tqdm
 
 import models
 import sim
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING, study_summary
-from experiments.measure.evaluation import goal_trajectory, strategy_of, movement_contacts
+from experiments.measure import reference_pool
+from experiments.measure.evaluation import goal_trajectory, movement_contacts, strategy_of
+from experiments.measure.reference_pool import CHUNK_COMMANDS, play_references, ring_placement
 from learner.agent import Agent
 from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
 from sim import Playroom
@@ -59,13 +62,6 @@ class StudyMeasureSettings:
     n_placements: int = 100
     random_commands_per_ring: int = RANDOM_COMMANDS_PER_RING
     seed: int = 20170001  # the trial's seed joins it: placements differ from run to run
-
-
-def _ring_placement(room: Playroom, ring: tuple[float, float], rng) -> np.ndarray:
-    """(3, 2) toys uniform in the ring (the study's `reset_toys(region)`: no clearance)."""
-    radius = rng.uniform(*ring, size=len(TOYS))
-    angle = rng.uniform(0.0, 2 * np.pi, size=len(TOYS))
-    return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=1)
 
 
 def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
@@ -85,7 +81,7 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
     rows = []
     for ring_number, ring in enumerate(room.config.toy_rings, start=1):
         for _ in range(settings.n_placements):
-            room.arrange(toys=_ring_placement(room, ring, rng))
+            room.arrange(toys=ring_placement(ring, rng))
             for t, toy in enumerate(TOYS, start=1):
                 context = room.context()
                 position = context[list(context_indices(toy))]
@@ -125,33 +121,27 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
 
 
 def random_reference(
-    room: Playroom, settings: StudyMeasureSettings, progress: bool | None = None, label: str = ""
-) -> pd.DataFrame:
-    """One row per random command: x, y of the goal toy and the error read on toy 1. progress:
-    a bar on stderr (None: only on a terminal), named `label`."""
-    rng = np.random.default_rng(settings.seed + 1)
-    rows = []
-    total = len(room.config.toy_rings) * settings.random_commands_per_ring
-    bar = tqdm(
-        total=total,
-        disable=None if progress is None else not progress,
-        desc=f"study reference{' ' + label if label else ''}",
-        unit="command",
+    configs: dict[str, dict],
+    settings: StudyMeasureSettings,
+    workers: int | None = None,
+    progress: bool | None = None,
+    chunk_commands: int = CHUNK_COMMANDS,
+) -> dict[str, pd.DataFrame]:
+    """The random reference of each group of `configs` (group -> a trial's config): one row per
+    random command, x, y of the goal toy and the error read on toy 1, ring by ring. Played in
+    chunks of `chunk_commands`, each from a fresh room with its own seed, on `workers`
+    processes (default: the cores), the same rows whatever their number
+    (experiments/measure/reference_pool.py: the scene carries over within a chunk only). A
+    group whose config makes no room is left out. progress: one bar on stderr (None: only on a
+    terminal)."""
+    return play_references(
+        configs,
+        settings.seed + 1,
+        settings.random_commands_per_ring,
+        workers=workers,
+        progress=progress,
+        chunk_commands=chunk_commands,
     )
-    for ring in room.config.toy_rings:
-        for k in range(settings.random_commands_per_ring):
-            if k % len(TOYS) == 0:
-                room.arrange(toys=_ring_placement(room, ring, rng))
-            context = room.context()
-            toy = TOYS[k % len(TOYS)]
-            position = context[list(context_indices(toy))]
-            space = "arm" if rng.random() < 0.5 else "voice"
-            s = room.act(space, rng.uniform(-1, 1, MOTOR_DIMS[space])).s
-            error = float(np.linalg.norm(s[block_slice("toy1")] - goal_trajectory(position)))
-            rows.append({"x": position[0], "y": position[1], "error": error})
-            bar.update(1)
-    bar.close()
-    return pd.DataFrame(rows)
 
 
 # Where played random references are kept between reports: this variable if set (tests,
@@ -173,9 +163,12 @@ def reference_cache_dir() -> Path:
 
 @functools.cache
 def _code_digest() -> str:
-    """A digest of what plays a reference (this module, the room's code, model and voice
-    data): a reference kept by another version of the project is not read back as this one's."""
+    """A digest of what plays a reference (this module and the pool's, the room's code, model
+    and voice data): a reference kept by another version of the project is not read back as
+    this one's."""
     digest = hashlib.sha256(Path(__file__).read_bytes())
+    assert reference_pool.__file__ is not None
+    digest.update(Path(reference_pool.__file__).read_bytes())
     for package in (sim, models):
         assert package.__file__ is not None  # regular packages, not namespace ones
         folder = Path(package.__file__).parent
@@ -211,38 +204,53 @@ def study_numbers(
     commands_per_ring: int = RANDOM_COMMANDS_PER_RING,
     cache_dir: Path | None = None,
     progress: bool | None = None,
+    workers: int | None = None,
+    chunk_commands: int = CHUNK_COMMANDS,
 ) -> dict[str, dict]:
     """`study_summary` of each group of a batch (`experiments.analysis.results.BatchResults`) whose
     trials hold the study's tests: their tests pooled over trials (the study averaged errors
-    per pixel over its runs), against a random reference played in a fresh room of the
-    group's settings. The reference depends on the settings and the code alone: it is kept in
-    `cache_dir` (default: `reference_cache_dir()`) as `study-reference-<digest>.parquet` and
-    read back by later reports, comparisons and ablations of any batch of those settings.
-    progress: a bar for each reference played (None: only on a terminal)."""
-    from experiments.run.trial_files import fresh_trial_parts
-
+    per pixel over its runs), against a random reference played in fresh rooms of the group's
+    settings (`random_reference`, every group not kept yet on one pool of `workers`
+    processes, default: the cores). The reference depends on the settings and the code alone:
+    it is kept in `cache_dir` (default: `reference_cache_dir()`) as
+    `study-reference-<digest>.parquet` and read back by later reports, comparisons and
+    ablations of any batch of those settings. progress: a bar of the commands played (None:
+    only on a terminal)."""
     cache = Path(cache_dir) if cache_dir is not None else reference_cache_dir()
-    numbers = {}
+    tests_of, paths, references, to_play = {}, {}, {}, {}
     for group, config in results.configs.items():
         tests = results.study_tests[results.study_tests["group"] == group]
         if tests.empty:
             continue
+        tests_of[group] = tests
+        # The trial's seed is not the reference's: one reference serves every trial.
         config = {**config, "trial": {**config["trial"], "seed": 0}}
         key = json.dumps(
-            {"config": config, "commands": commands_per_ring, "code": _code_digest()},
+            {
+                "config": config,
+                "commands": commands_per_ring,
+                "chunk": chunk_commands,
+                "code": _code_digest(),
+            },
             sort_keys=True,
         )
         digest = hashlib.sha256(key.encode()).hexdigest()[:16]
-        cached = cache / f"study-reference-{digest}.parquet"
-        reference = _read_kept(cached)
-        if reference is None:
-            try:
-                _, room = fresh_trial_parts(config)
-            except ValueError:  # settings no room can be built from: the row says "not measured"
-                continue
-            settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
-            reference = random_reference(room, settings, progress, label=group)
-            _keep(cached, reference)
-        numbers[group] = study_summary(tests, reference)
+        paths[group] = cache / f"study-reference-{digest}.parquet"
+        kept = _read_kept(paths[group])
+        if kept is None:
+            to_play[group] = config
+        else:
+            references[group] = kept
+    if to_play:  # every group not kept yet on one pool: two groups share the cores
+        settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
+        played = random_reference(to_play, settings, workers, progress, chunk_commands)
+        for group, reference in played.items():
+            _keep(paths[group], reference)
+        references.update(played)
+    numbers = {}
+    for group, tests in tests_of.items():
+        if group not in references:  # settings no room can be built from: "not measured"
+            continue
+        numbers[group] = study_summary(tests, references[group])
         numbers[group]["reference_commands_per_ring"] = commands_per_ring
     return numbers

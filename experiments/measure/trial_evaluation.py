@@ -5,10 +5,17 @@ written into the trial directory as one unit (eval.json last)."""
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 from experiments import provenance, storage
-from experiments.file_names import COMPETENCE_FILE, EVAL_FILE, STUDY_TESTS_FILE, VOCAL_FILE
+from experiments.file_names import (
+    COMPETENCE_FILE,
+    CONFIG_FILE,
+    EVAL_FILE,
+    STUDY_TESTS_FILE,
+    VOCAL_FILE,
+)
 from experiments.measure.evaluation import (
     EvaluationSettings,
     competence_table,
@@ -17,20 +24,28 @@ from experiments.measure.evaluation import (
 )
 from experiments.measure.study_measure import StudyMeasureSettings, study_tests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_checks import load_trial, remove_litter
 from experiments.run.trial_files import TrialError, TrialLocked
 
 
 def evaluate_trial(
-    trial_dir: str | os.PathLike, settings: EvaluationSettings | None = None, progress=False
+    trial_dir: str | os.PathLike,
+    settings: EvaluationSettings | None = None,
+    progress=False,
+    notify: Callable[[str], None] | None = None,
 ) -> dict:
     """Evaluate a trial's final state and write eval.json and the tables beside it, as one
     unit: a write that fails (disk full) leaves the trial's evaluation files as they were.
-    TrialError, before any work, for a directory that cannot be written (read-only)."""
+    TrialError, before any work, for a directory that cannot be written (read-only), or that
+    another process writes into (named). The temporary files of killed writers are removed
+    first; `notify` is told their names."""
     settings = settings or EvaluationSettings()
     trial_dir = Path(trial_dir)
-    config, agent, room, meta = load_trial(trial_dir)
-    # Evaluation writes into the trial directory: one writer at a time, as for the trial.
+    if not (trial_dir / CONFIG_FILE).is_file():  # the lock would make the folder
+        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    # Evaluation writes into the trial directory: one writer at a time, as for the trial. Taken
+    # before the trial is read: a live writer's files are caught mid-change (its checkpoint
+    # between two renames), and it is the writer that must be named.
     try:
         lock = DirectoryLock(trial_dir).acquire()
     except DirectoryLocked as exc:
@@ -38,6 +53,12 @@ def evaluate_trial(
     except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
         raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
     try:
+        config, agent, room, meta = load_trial(trial_dir)
+        litter = remove_litter(trial_dir)  # under the lock: their writers are dead
+        if litter and notify is not None:
+            notify(
+                f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
+            )
         try:  # before minutes of tests whose results could not be kept
             storage.check_writable(trial_dir)
         except OSError as exc:

@@ -37,9 +37,17 @@ from experiments.analysis.stats import (
     welch,
 )
 from experiments.file_names import COMPARISON_FILE
-from experiments.report import intro, name_strategies, paper, tool_rule
+from experiments.report import (
+    intro,
+    mechanisms,
+    name_strategies,
+    paper,
+    strategy_definitions,
+    tool_rule,
+)
 from experiments.report.batch_report import numbers_and_figures
 from experiments.report.figures import FigureFile
+from experiments.report.mechanism_figures import mechanism_figures
 from experiments.report.pages import (
     Table,
     ci_text,
@@ -248,11 +256,13 @@ def difference_rows(
     return [
         *_competence_rows(a, b),
         *_strategy_rows(a, b, geometry),
+        *strategy_definitions.comparison_rows(a, b, geometry),
         *_vocal_rows(a, b, geometry.threshold),
         *_stick_rows(a, b, geometry),
         *tool_rule.comparison_rows(a, b),
         *_grasp_rate_row(a, b, grasp_rate_commands, measures),
         *_cost_rows(a, b),
+        *mechanisms.comparison_rows(a, b),
     ]
 
 
@@ -275,6 +285,7 @@ def write_comparison(
     check_out_dir(Path(out_dir))
     merged = a.merge(b)
     geometry, numbers, published, page_figures = numbers_and_figures(merged, measures)
+    page_figures += mechanism_figures(merged, geometry)
     figures = [FigureFile(f"comparison-{f.name}", f.title, f.caption, f.png) for f in page_figures]
     g = merged.groups
     computed_on = provenance.short_record(provenance.machine_record())  # this page's machine
@@ -313,4 +324,7 @@ def write_comparison(
         computed_on=computed_on,
         tests=tests,
     )
+    # Both definitions of "tool", with intervals over trials (issue 32: like with like).
+    for group, numbers_of in strategy_definitions.summary_numbers(merged, geometry).items():
+        content["by_group"][group]["strategy_definitions"] = numbers_of
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page, summary_files(content))

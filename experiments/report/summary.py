@@ -37,6 +37,7 @@ import numpy as np
 import pandas as pd
 
 from experiments import storage
+from experiments.analysis.mechanisms import LABELS
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
 from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
@@ -58,6 +59,7 @@ TRIAL_NUMBERS = (
     "stick_returns",
     "seconds",
     "timed_iterations",
+    *LABELS,  # what the logs say of the mechanisms (experiments/analysis/mechanisms.py)
 )
 
 

@@ -21,6 +21,7 @@ from experiments import storage
 from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
+from models.checks import INT64_MAX, check_seed
 from models.presets import DEFAULT_PRESET, PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS, WorldConfig, world_preset
@@ -28,6 +29,11 @@ from sim.grasping.names import DEFAULT_GRASP, GRASPS
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.diva.data import DivaDataError, DivaDataMissing, installed_fit
+
+# Bounds of the trial's own settings. Iterations are logged as int64. A checkpoint period's rows
+# are held in memory until its checkpoint writes them, about a kilobyte each: a million is a GB.
+ITERATIONS_MAX = INT64_MAX
+CHECKPOINT_EVERY_MAX = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -66,12 +72,22 @@ class TrialSettings:
             raise TrialError(
                 f"unknown stick_return {self.stick_return!r}: one of {', '.join(STICK_RETURNS)}"
             )
-        for name in ("iterations", "checkpoint_every"):
+        for name, maximum in (
+            ("iterations", ITERATIONS_MAX),
+            ("checkpoint_every", CHECKPOINT_EVERY_MAX),
+        ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
                 raise TrialError(f"{name} must be a positive integer, got {value!r}")
+            if value > maximum:
+                shown = "2**63 - 1" if maximum == INT64_MAX else str(maximum)
+                raise TrialError(f"{name} must be at most {shown}, got {value!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise TrialError(f"seed must be a non-negative integer, got {self.seed!r}")
+        try:  # every log row holds the seed in an int64 column
+            check_seed("seed", self.seed)
+        except ValueError as exc:
+            raise TrialError(str(exc)) from None
 
 
 # Override sections, their configs, and the fields a trial setting owns: an override of one

@@ -18,14 +18,13 @@ import os
 import shutil
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
 from experiments import provenance, storage
-from experiments.analysis.log_chunks import chunk_path
+from experiments.analysis.log_chunks import CHUNK_IDENTITY_KEY, EXTENSIBLE, chunk_path
 from experiments.analysis.logs import SOURCE_COLUMNS, source_of
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
@@ -38,12 +37,11 @@ from experiments.file_names import (
     STALE_PREFIX,
     TRIAL_ENTRIES,
 )
-from experiments.run import stop_requests
+from experiments.run import estimate, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
-from experiments.run.trial_checks import drop_logs_past, prepare_resume
+from experiments.run.trial_checks import drop_logs_past, is_litter, prepare_resume, remove_litter
 from experiments.run.trial_files import (
-    EXTENSIBLE,
     LEARNER_COLUMNS,
     LEARNER_DTYPE,
     LOG_README,
@@ -54,6 +52,7 @@ from experiments.run.trial_files import (
     learner_values,
     log_row,
     trial_identity,
+    trial_path,
 )
 from models.layout import TOYS, block_slice
 
@@ -66,10 +65,10 @@ class Trial:
     creation until `close` (or the end of the process)."""
 
     def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
-        self.dir = Path(out_dir)
+        self.dir = trial_path(out_dir)
         self.settings = settings
         self.config = full_config(settings)
-        self.identity = trial_identity(self.config)  # carried by every checkpoint
+        self.identity = trial_identity(self.config)  # carried by every checkpoint and log chunk
         self.source = source_of(self.dir, self.config)  # first in every log row
         self.notices: list[str] = []  # one line each: what a resume had to do
         self._refuse_foreign_path()
@@ -80,8 +79,10 @@ class Trial:
         except OSError as exc:
             raise TrialError(f"cannot write into {self.dir}: {exc.strerror}") from None
         try:
-            self._check_directory(resume)
+            # Built before anything is written: a config that makes no room or agent leaves
+            # the directory as it was.
             self.agent, self.room = fresh_trial_parts(self.config)
+            self._check_directory(resume)
             self.iteration = 0
             self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
             self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
@@ -106,12 +107,14 @@ class Trial:
 
     # Directory rules ----------------------------------------------------------------------
     def _refuse_foreign_path(self) -> None:
-        """Before anything is written: a file, or a folder of something else, is refused."""
+        """Before anything is written: a file, or a folder of something else, is refused (a
+        folder of a new trial killed while writing its first file holds the lock and that
+        file's temporary: it is the same command's to use again)."""
         d = self.dir
         if d.exists() and not d.is_dir():
             raise TrialError(f"{d} is a file, not a directory")
         if d.is_dir() and not (d / CONFIG_FILE).exists():
-            if any(p.name != LOCK_FILE for p in d.iterdir()):
+            if any(p.name != LOCK_FILE and not is_litter(p.name) for p in d.iterdir()):
                 raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
 
     def _check_directory(self, resume: bool) -> None:
@@ -141,6 +144,7 @@ class Trial:
         except OSError as exc:
             raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
         if not config_path.exists():
+            remove_litter(d)  # under the lock: a killed first write's (`_refuse_foreign_path`)
             try:
                 storage.write_json(config_path, self.config)
             except OSError:
@@ -307,11 +311,14 @@ class Trial:
     def _write_chunk(
         self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
     ) -> None:
-        """One chunk of a log, in its kind's folder, its source columns first."""
+        """One chunk of a log, in its kind's folder, its source columns first, carrying the
+        trial's identity."""
         for position, column in enumerate(SOURCE_COLUMNS):
             table.insert(position, column, self.source[column])
         path = chunk_path(self.dir, kind, start)
         path.parent.mkdir(exist_ok=True)
+        # Written into the Parquet schema's metadata (experiments/analysis/log_chunks.py).
+        table.attrs[CHUNK_IDENTITY_KEY] = self.identity
         storage.write_table(path, table, plain=plain)
 
 
@@ -326,7 +333,12 @@ def run_trial(
 ) -> Trial:
     """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
     the run, with each line a resume has to report (a fallback checkpoint, an extension);
-    `report` with the iteration reached, every `report_every` iterations and at the end."""
+    `report` with the iteration reached, every `report_every` iterations and at the end.
+    A trial that will not fit on its disk is refused first (TrialError); a long one is told
+    to `notify`, first, with its expected time and disk (experiments/run/estimate.py)."""
+    line = estimate.check_fits(trial_path(out_dir), settings, resume)
+    if line is not None and notify is not None:
+        notify(line)
     trial = Trial(out_dir, settings, resume=resume)
     if notify is not None:
         for notice in trial.notices:

@@ -1,11 +1,13 @@
 """Reading a trial directory back only when it is whole, and saying truly what is not.
 
-- A checkpoint is used only if it is the trial's own (its identity, trial_files.trial_identity)
+- A checkpoint is used only if it is the trial's own (its identity, log_chunks.trial_identity)
   and readable; the newest is preferred, the previous one is the fallback of a resume only.
-- The log chunks a checkpoint covers must be present and hold what their names say: a lost
-  chunk cannot be regenerated (except by running the trial again from scratch), so whatever
-  finds one stops, names it, and changes nothing.
-- Temporary files of writers killed mid-write are litter, removed by a resume, never results.
+- The log chunks a checkpoint covers must be present, the trial's own (the identity they
+  carry, if they carry one) and hold what their names say: a lost chunk cannot be regenerated
+  (except by running the trial again from scratch), so whatever finds one stops, names it, and
+  changes nothing.
+- Temporary files of writers killed mid-write are litter, removed by every writer under the
+  lock (a resume, an evaluation), never results.
 - Logs of the old layout (chunks of both kinds side by side in log/) are read as they are, and
   brought into their kinds' folders by a resume (experiments/run/old_logs.py).
 """
@@ -18,8 +20,11 @@ from pathlib import Path
 from experiments import storage
 from experiments.analysis.log_chunks import (
     DuplicateChunkError,
+    ForeignChunkError,
+    check_chunk,
     chunk_path,
     chunk_paths,
+    trial_identity,
 )
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
@@ -85,7 +90,7 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
         )
     if meta["iteration"] == 0:
         raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
-    check_logs(trial_dir, int(meta["iteration"]))
+    check_logs(trial_dir, int(meta["iteration"]), config)
     return config, agent, room, meta
 
 
@@ -98,14 +103,18 @@ def _chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
         raise TrialError(f"{exc}; nothing was changed") from None
 
 
-def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
+def check_logs(trial_dir: str | os.PathLike, iteration: int, config: dict | None = None) -> None:
     """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
-    is missing, unreadable, or holds other rows than its name and period say: the iterations
-    chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
-    WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later
-    are work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of
-    both layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
+    is missing, unreadable, of another trial than `config`'s (the trial's config.json if None),
+    or holds other rows than its name and period say: the iterations chunks hold 0 to
+    `iteration` - 1 without a gap, each words chunk the multiples of WORDS_LOG_PERIOD its
+    iterations chunk reaches. Chunks starting at `iteration` or later are work past the
+    checkpoint (a resume rewrites them) and are not looked at. Chunks of both layouts
+    (log/iterations/ and log/words/, or side by side in log/) are read."""
     trial_dir = Path(trial_dir)
+    if config is None:
+        config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+    own = trial_identity(config)
     found = {
         kind: {s: p for s, p in _chunks(trial_dir, kind).items() if s < iteration}
         for kind in LOG_KINDS
@@ -117,7 +126,7 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
             end = min((s for s in found["iterations"] if s > start), default=iteration)
             raise TrialError(_lost(f"{path} is missing (iterations {start} to {end - 1})"))
         path = found["iterations"][start]
-        end = start + _check_rows(path, range(start, iteration), whole=False)
+        end = start + _check_rows(path, range(start, iteration), (trial_dir, own), whole=False)
         # The words rows this period reached: the multiples of the period in (start, end].
         reached = range(
             (start // WORDS_LOG_PERIOD + 1) * WORDS_LOG_PERIOD, end + 1, WORDS_LOG_PERIOD
@@ -126,17 +135,21 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int) -> None:
         if reached and not words.exists():
             raise TrialError(_lost(f"{words} is missing (words at {reached[0]} to {reached[-1]})"))
         if words.exists():
-            _check_rows(words, reached, whole=True)
+            _check_rows(words, reached, (trial_dir, own), whole=True)
         start = end
     for words in found["words"].values():
         raise TrialError(_lost(f"{words} starts where no iterations chunk starts"))
 
 
-def _check_rows(path: Path, expected: range, whole: bool) -> int:
-    """The number of rows of a log chunk, whose iterations must be the first of `expected`
-    (all of them if `whole`); TrialError naming the chunk otherwise."""
+def _check_rows(path: Path, expected: range, trial: tuple[Path, dict], whole: bool) -> int:
+    """The number of rows of a log chunk of `trial` (its directory and identity), whose
+    iterations must be the first of `expected` (all of them if `whole`); TrialError naming the
+    chunk otherwise."""
     try:
         rows = storage.read_column(path, "iteration")
+        check_chunk(path, trial[1], trial[0])
+    except ForeignChunkError as exc:
+        raise TrialError(_lost(str(exc))) from None
     except storage.CorruptFileError as exc:
         raise TrialError(_lost(_first_line(exc))) from None
     if not rows or rows != list(expected[: len(rows)]) or (whole and len(rows) != len(expected)):
@@ -169,6 +182,12 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def is_litter(name: str) -> bool:
+    """Whether a file named `name` is a temporary file of a writer that no longer runs."""
+    pid = storage.temporary_writer(name)
+    return pid is not None and not _alive(pid)
+
+
 def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     """Remove the temporary files that writers killed mid-write (storage.write_bytes) left in a
     trial directory and its log/; returns their names (relative to the directory).
@@ -183,8 +202,7 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     log = trial_dir / LOG_DIR
     for folder in (trial_dir, log, *(log / kind for kind in LOG_KINDS)):
         for path in sorted(folder.glob(".*.tmp")):
-            pid = storage.temporary_writer(path.name)
-            if pid is not None and not _alive(pid):
+            if is_litter(path.name):
                 path.unlink(missing_ok=True)
                 removed.append(str(path.relative_to(trial_dir)))
     return removed
@@ -215,7 +233,7 @@ def prepare_resume(
         restored = None
     else:
         agent, room, meta, fallback = restore_newest(trial_dir, config)
-        check_logs(trial_dir, int(meta["iteration"]))
+        check_logs(trial_dir, int(meta["iteration"]), config)
         restored = agent, room, meta
         if "identity" not in meta:
             notices.append(

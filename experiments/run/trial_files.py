@@ -10,8 +10,9 @@ A trial directory holds:
   iteration NNNNNNNN;
 - `log/words/chunk-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to
   each of the 6 words, in the chunk of the period that reaches them;
-  every row of both carries its source (trial, seed, backend, voice); the columns are listed in
-  experiments/analysis/logs.py, which reads them back (trials of the old layout too:
+  every row of both carries its source (trial, seed, backend, voice), and every chunk its
+  trial's identity, as checkpoints do (experiments/analysis/log_chunks.py); the columns are
+  listed in experiments/analysis/logs.py, which reads them back (trials of the old layout too:
   log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
 - `log/README.txt`: which folder of log/ to read (a reader of all of log/ stops on it);
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
@@ -24,15 +25,14 @@ when it is whole (its checkpoint its own and readable, the logs it covers comple
 
 from __future__ import annotations
 
-import hashlib
-import json
+import errno
 import os
 from pathlib import Path
 
 import numpy as np
 
 from experiments import storage
-from experiments.config_file import identity_form
+from experiments.analysis.log_chunks import identity_text, trial_identity
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
@@ -68,14 +68,6 @@ LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
 # of float64 (random goals hardly compress). The other columns keep their types.
 LEARNER_DTYPE = np.float32
 _NO_BLOCK = np.full(BLOCK_DIM, np.nan)
-
-# Settings a resume may change: a trial can be extended to more iterations.
-EXTENSIBLE = ("trial.iterations",)
-# What a checkpoint's identity leaves out of its trial's config: the settings a resume may
-# change, and the package version. The version says which code wrote config.json, not which
-# trial it is; in the identity it would orphan every checkpoint at each release (whether a
-# trial may be resumed by another version is for the config comparison on resume to say).
-_NOT_IDENTITY = (*EXTENSIBLE, "package_version")
 
 
 # The agent's random generator is seeded apart from the room's, from the same trial seed.
@@ -153,6 +145,25 @@ def learner_values(
     )
 
 
+def trial_path(out_dir: str | os.PathLike) -> Path:
+    """`out_dir` as a Path, if it can name a directory; TrialError (one line) for a symbolic
+    link loop, which no directory can be made or found at."""
+    path = Path(out_dir)
+    try:
+        path.resolve()  # Python 3.11 raises RuntimeError on a loop
+        path.stat()  # later versions resolve it as it is: the system says ELOOP
+    except FileNotFoundError:  # a trial to be made: its folder is created by the run
+        pass
+    except (RuntimeError, OSError) as exc:
+        if isinstance(exc, RuntimeError) or exc.errno == errno.ELOOP:
+            raise TrialError(
+                f"{path} cannot be used: it is a symbolic link loop (a link that leads back to "
+                "itself); choose another directory"
+            ) from None
+        # Anything else (a parent that is a file, no permission) is said where it is used.
+    return path
+
+
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     """The agent and room of a trial's iteration 0, as its config makes them. TrialConfigError
     (one line) for a config that makes none: a config.json edited by hand, or written before the
@@ -174,21 +185,6 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     return agent, room
 
 
-def trial_identity(config: dict) -> dict:
-    """What a checkpoint carries of its trial (in its metadata): the seed, and a hash of the
-    trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
-    kept = identity_form(config)  # a copy, as older trials' configs would read
-    for key in _NOT_IDENTITY:
-        *parents, last = key.split(".")
-        node = kept
-        for parent in parents:
-            node = node.get(parent, {})
-        node.pop(last, None)
-    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
-    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
-    return {"seed": config["trial"]["seed"], "config": digest}
-
-
 def check_identity(path: Path, meta: dict, config: dict) -> None:
     """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
     A checkpoint without identity (written before checkpoints carried one) is taken as the
@@ -196,12 +192,9 @@ def check_identity(path: Path, meta: dict, config: dict) -> None:
     found, own = meta.get("identity"), trial_identity(config)
     if found is None or found == own:
         return
-    seed, digest = (
-        (found.get("seed"), found.get("config")) if isinstance(found, dict) else 2 * ("?",)
-    )
     raise TrialError(
-        f"{path.name} belongs to another trial (seed {seed}, config {digest}) than "
-        f"{path.parent} (seed {own['seed']}, config {own['config']}); refusing to mix them"
+        f"{path.name} belongs to another trial ({identity_text(found)}) than "
+        f"{path.parent} ({identity_text(own)}); refusing to mix them"
     )
 
 

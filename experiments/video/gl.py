@@ -5,7 +5,8 @@ then: with it unset they load GLFW, with `egl` PyOpenGL's EGL, which fails on ma
 libEGL cannot be loaded (most cluster nodes). So the `playroom` command decides before anything
 imports mujoco: commands that render ask for a backend (EGL unless the user chose another),
 every other command asks for none, so `run`, `eval`, `batch`, `report` and `compare` work on a
-machine without any GL library. A user's own `MUJOCO_GL` is always respected.
+machine without any GL library. A user's own `MUJOCO_GL` is always respected: one that names a
+library that cannot be loaded stops every command in one line saying so.
 """
 
 from __future__ import annotations
@@ -38,9 +39,23 @@ def choices() -> str:
 
 
 def without_rendering() -> None:
-    """For commands that never render: load no GL library (unless the user chose one)."""
+    """For commands that never render: load no GL library (unless the user chose one); GLError
+    in one line if the user's choice names a library that cannot be loaded, which mujoco's
+    import would otherwise fail on."""
     if "mujoco" not in sys.modules:
         os.environ.setdefault(VARIABLE, NO_BACKEND)
+        unloadable = unloadable_library(os.environ[VARIABLE])
+        if unloadable is not None:
+            raise GLError(unloadable)
+
+
+def unloadable_library(backend: str) -> str | None:
+    """The one-line message for a backend whose system library is there but cannot be loaded
+    (an empty or broken libEGL.so.1 on a cluster node), else None: sim's check, which the first
+    import of mujoco runs too (sim/__init__.py)."""
+    from sim import gl_library_problem
+
+    return gl_library_problem(backend)
 
 
 def for_viewing() -> None:
@@ -78,7 +93,7 @@ def for_rendering() -> str:
     chosen = os.environ.setdefault(VARIABLE, DEFAULT_RENDER_BACKEND).strip().lower()
     if chosen not in RENDER_BACKENDS:
         raise GLError(f"{VARIABLE}={chosen!r} cannot render: {choices()}")
-    missing = missing_library(chosen)
+    missing = missing_library(chosen) or unloadable_library(chosen)
     if missing is not None:
         raise GLError(missing)
     try:

@@ -7,8 +7,10 @@ iterations (one step = one arm or voice command, as the study's agent acts):
   spaces, registered as "Playroom-v0" when this package is imported, so that
   `gymnasium.make("sim.envs:Playroom-v0", grasp="physical")` works without importing it first.
 
-Both build each episode's `Playroom` from its seed; `room.env`, the room's own dm_control
-Environment, is only its internal stepping (sim/task.py, `MovementStepper`). The classes load
+Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
+(sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
+episode's `Playroom` from its seed; `room.env`, the room's own dm_control Environment, is only
+its internal stepping (sim/task.py, `MovementStepper`). The classes load
 on first use, so that registering costs no MuJoCo.
 """
 
@@ -16,7 +18,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from gymnasium.envs.registration import register, registry
+from sim import environment_kept
+
+# Gymnasium sets PYGAME_HIDE_SUPPORT_PROMPT when first imported; importing sim changes no
+# environment variable, so it is put back.
+with environment_kept():
+    from gymnasium.envs.registration import register, registry
 
 if TYPE_CHECKING:
     from sim.envs.dm_env_movement import PlayroomMovementEnv

@@ -3,8 +3,9 @@ arm command (21 parameters) or one voice command (28), as the study's agent acts
 
 The action is a dict, dm_env's nested form for a choice plus its parameters:
 `{"motor_space": 0 (arm) or 1 (voice), "arm": (21,) in [-1, 1], "voice": (28,) in [-1, 1]}`.
-The command of the motor space not chosen is ignored and may be left out; `motor_space` may
-also be its name ("arm", "voice").
+The command of the motor space not chosen is ignored and may be left out, but is checked when
+given, as the Gymnasium form checks its whole action; `motor_space` may also be its name ("arm",
+"voice").
 
 The observation is a dict: `context` (10,), the stick handle, toy1-3 and caregiver x, y before
 the next command (models/layout.py); `feedback` (60,), the last movement's sensory feedback
@@ -33,9 +34,10 @@ import dm_env
 import numpy as np
 from dm_env import specs
 
-from models.layout import ARM_DIM, CONTEXT_DIM, MOTOR_SPACES, SENSORY_DIM, VOICE_DIM
+from models.layout import ARM_DIM, CONTEXT_DIM, MOTOR_DIMS, MOTOR_SPACES, SENSORY_DIM, VOICE_DIM
 from models.world import Feedback
 from sim.config import WorldConfig
+from sim.envs.actions import checked_numbers
 from sim.envs.world import (
     EVENT_KINDS,
     SEED_BOUND,
@@ -135,7 +137,7 @@ class PlayroomMovementEnv(dm_env.Environment):
 
 def motor_command(action: object) -> tuple[str, Any]:
     """(motor space, its command) of a dict action; ValueError in one line naming what is
-    wrong. The command's shape, values and range are checked by `Playroom.act`."""
+    wrong (sim/envs/actions.py: real finite numbers of the command's shape in [-1, 1])."""
     if not isinstance(action, Mapping):
         raise ValueError(f"the action must be a dict {ACTION_FORM}, got {type(action).__name__}")
     unknown = sorted(map(str, set(action) - set(ACTION_KEYS)))
@@ -155,4 +157,11 @@ def motor_command(action: object) -> tuple[str, Any]:
         raise ValueError(f"unknown motor space {name!r}: one of {MOTOR_SPACES}")
     if name not in action:
         raise ValueError(f"the action chooses the {name} but holds no {name!r} command")
-    return name, action[name]
+    # Every command given is checked, the one not chosen included, as the Gymnasium form checks
+    # its whole flat action: a NaN there is a fault of the learner in either form.
+    commands = {
+        space: checked_numbers(action[space], MOTOR_DIMS[space], f"the {space} command")
+        for space in MOTOR_SPACES
+        if space in action
+    }
+    return name, commands[name]

@@ -5,6 +5,7 @@ and batch.json, which records what the batch is (its reports' reference size).""
 from __future__ import annotations
 
 import logging
+import threading
 import urllib.request
 
 import pytest
@@ -56,8 +57,8 @@ def test_a_batch_prints_the_link_and_advances_within_each_trial(
     seen: list[tuple[str, int, list[str]]] = []
     original = progress_module.BatchProgress.reached
 
-    def recording(self, name: str, iteration: int) -> None:
-        original(self, name, iteration)
+    def recording(self, name: str, iteration: int, *where) -> None:
+        original(self, name, iteration, *where)
         seen.append((name, iteration, self.running()))
 
     monkeypatch.setattr(progress_module.BatchProgress, "reached", recording)
@@ -96,7 +97,22 @@ def test_the_bar_names_running_trials_and_counts_the_rest():
     assert shown.iterations_done() == 10 + 4 * 4  # t0 counted whole once done
     shown.reached("t2", 99)  # never past a trial's own length
     assert shown.iterations_done() == 10 + 4 * 4 + 6
-    assert "running 3: t2, t3, t4" in str(shown.bar.postfix)
+    assert "running 3: t2, t3, t4" in shown.postfix()
+    shown.close()
+
+
+def test_the_bar_counts_one_trial_per_task_thread_and_none_after_its_end():
+    shown = progress_module.BatchProgress({"a": 10, "b": 10, "c": 10}, enabled=False)
+    shown.reached("a", 0, "worker1/7")
+    shown.reached("b", 0, "worker2/7")
+    shown.reached("c", 0, "worker1/7")  # worker1's next trial, before a's end was seen
+    assert shown.running() == ["b", "c"]  # 2 threads: never 3 running
+    shown.ended("a", failed=False)
+    shown.reached("a", 5, "worker1/7")  # a's last report, arriving after its end
+    assert shown.running() == ["b", "c"] and shown.iterations_done() == 10
+    shown.ended("c", failed=False)
+    shown.ended("b", failed=True)
+    assert shown.running() == [] and "done 2, failed 1, running 0" in shown.postfix()
     shown.close()
 
 
@@ -128,6 +144,8 @@ def test_a_trial_reports_its_start_then_at_most_once_a_while(monkeypatch):
     sent: list[dict] = []
 
     class Worker:
+        address = "tcp://worker"
+
         def log_event(self, topic: str, message: dict) -> None:
             sent.append(message)
 
@@ -136,8 +154,9 @@ def test_a_trial_reports_its_start_then_at_most_once_a_while(monkeypatch):
     assert seldom is not None
     for iteration in (0, 100, 200):
         seldom(iteration)
-    assert sent == [{"trial": "trial", "iteration": 0}]
+    here = f"tcp://worker/{threading.get_ident()}"  # the task thread that runs the trial
+    assert sent == [{"trial": "trial", "iteration": 0, "thread": here}]
     every_time = progress_module.reporter("topic", "trial", min_interval_s=0.0)
     assert every_time is not None
     every_time(300)
-    assert sent[-1] == {"trial": "trial", "iteration": 300}
+    assert sent[-1] == {"trial": "trial", "iteration": 300, "thread": here}

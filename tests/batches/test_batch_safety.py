@@ -18,6 +18,7 @@ from experiments.batches import scheduler as scheduler_module
 from experiments.batches.runner import run_batch
 from experiments.batches.spec import BatchError, BatchSpec, load_spec
 from experiments.cli.main import main
+from models.checks import MAX_SEED
 
 TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_every=10)
 
@@ -36,6 +37,10 @@ TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_ev
         ({"seeds": [True]}, "seeds must be a positive count"),
         ({"seeds": 0}, "seeds must be a positive count"),
         ({"seeds": []}, "seeds must be a positive count"),
+        ({"seeds": 99999999999999999999999}, "seeds must be a positive count (seeds 0..N-1) up"),
+        ({"seeds": 100001}, "seeds must be a positive count (seeds 0..N-1) up to 100000"),
+        ({"seeds": [99999999999999999999999]}, "integers in [0, 2**63 - 1], got [99999"),
+        ({"seeds": [0, 2**63]}, "integers in [0, 2**63 - 1], got [0, 9223372036854775808]"),
         ({"grasps": []}, "grasps must be a non-empty list of distinct values from kinematic"),
         ({"grasps": "kinematic"}, "grasps must be a non-empty list"),
         ({"grasps": ["kinematic", "kinematic"]}, "grasps must be a non-empty list"),
@@ -51,7 +56,10 @@ TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_ev
         ({"study_reference_commands": 0}, "study_reference_commands must be a positive integer"),
         ({"study_reference_commands": 3.5}, "study_reference_commands must be a positive integer"),
         ({"study_reference_commands": "300"}, "study_reference_commands must be a positive"),
-        ({"base": "nope"}, "base must be the name of a stored profile (comparison, demo"),
+        (
+            {"base": "nope"},
+            "base must be the name of a stored profile (comparison, comparison-diva, demo",
+        ),
         ({"base": 1}, "base must be the name of a stored profile"),
         ({"base": "smoke", "iterations": 0}, "iterations must be a positive integer"),
         ({"sede": 3}, "unknown field(s) sede"),
@@ -78,6 +86,9 @@ def test_a_good_batch_config_is_taken_as_written(tmp_path):
     assert spec.seeds == (7, 3) and spec.grasps == ("physical",) and spec.iterations == 50
     path.write_text(json.dumps({"seeds": 2}))
     assert load_spec(config_file=path).seeds == (0, 1)
+    # The largest seed a log's int64 seed column holds (models/checks.py).
+    path.write_text(json.dumps({"seeds": [MAX_SEED]}))
+    assert load_spec(config_file=path).seeds == (MAX_SEED,) == (2**63 - 1,)
 
 
 class _Service(socketserver.ThreadingTCPServer):

@@ -329,3 +329,32 @@ def test_write_files_is_all_or_nothing(tmp_path, monkeypatch):
     monkeypatch.undo()
     assert storage.write_files(folder, {"one": b"1", "two": b"2"})[-1] == folder / "two"
     assert _files(folder) == {"one": b"1", "two": b"2"}
+
+
+# Requests that ended in a traceback (issue 31): one line, exit code 2, nothing written ------
+TRACEBACKS = {
+    # pyarrow could not write the seed into the log's int64 column.
+    "seed beyond int64": (["--seed", "99999999999999999999999"], "seed must be"),
+    # A 14.6 TiB allocation, and a dimension beyond NumPy's: after config.json was written.
+    "window of 14.6 TiB": (["--set", "learner.progress_window=100000000000"], "progress_window"),
+    "window beyond NumPy": (["--set", "learner.progress_window=99999999999999999999"], "window"),
+}
+
+
+@pytest.mark.parametrize("request_", TRACEBACKS, ids=list(TRACEBACKS))
+def test_a_request_that_raised_a_traceback_is_one_line_and_writes_nothing(
+    tmp_path, capsys, request_
+):
+    args, says = TRACEBACKS[request_]
+    out = tmp_path / "t"
+    assert main(["run", "--out", str(out), "--iterations", "40", "--quiet", *args]) == 2
+    _one_line(capsys.readouterr().err, says, args[-1].split("=")[-1])
+    assert not out.exists()  # the same directory is free for the corrected command
+
+
+def test_a_symlink_loop_as_out_is_one_line_and_changes_nothing(tmp_path, capsys):
+    loop = tmp_path / "loop"
+    loop.symlink_to(loop)
+    assert main(["run", "--out", str(loop), "--iterations", "40", "--quiet"]) == 2
+    _one_line(capsys.readouterr().err, str(loop), "symbolic link")
+    assert list(tmp_path.iterdir()) == [loop] and loop.is_symlink()

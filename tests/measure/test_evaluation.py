@@ -15,9 +15,9 @@ from experiments.measure.evaluation import (
     EvaluationSettings,
     competence_table,
     goal_trajectory,
+    movement_contacts,
     normalised_competence,
     strategy_of,
-    movement_contacts,
 )
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.trial_checks import load_trial

@@ -11,23 +11,22 @@ from experiments.cli.commands import _study_reference
 from experiments.file_names import BATCH_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference
-from sim import Playroom
+from experiments.run.settings import TrialSettings, full_config
 
 
 def test_the_random_reference_draws_a_bar_of_its_commands(capsys):
-    room = Playroom("kinematic", seed=0)
+    config = full_config(TrialSettings(grasp="kinematic", seed=0))
     reference = random_reference(
-        room, StudyMeasureSettings(random_commands_per_ring=2), progress=True, label="kin"
-    )
+        {"kin": config}, StudyMeasureSettings(random_commands_per_ring=2), progress=True
+    )["kin"]
     assert len(reference) == 6  # 3 rings x 2 commands
     err = capsys.readouterr().err
     assert "study reference kin" in err and "6/6" in err
 
 
 def test_no_bar_unless_asked_or_on_a_terminal(capsys):
-    random_reference(
-        Playroom("kinematic", seed=0), StudyMeasureSettings(random_commands_per_ring=1)
-    )
+    config = full_config(TrialSettings(grasp="kinematic", seed=0))
+    random_reference({"kin": config}, StudyMeasureSettings(random_commands_per_ring=1))
     assert capsys.readouterr().err == ""  # pytest's stderr is no terminal
 
 

@@ -104,12 +104,12 @@ def test_the_arm_model_is_asked_with_the_voice_models_context_values():
 
 
 def test_tests_and_reference_on_a_trained_trial(trained_trial):
-    _, agent, room, _ = load_trial(trained_trial.dir)
+    config, agent, room, _ = load_trial(trained_trial.dir)
     settings = StudyMeasureSettings(n_placements=2, random_commands_per_ring=9)
     tests = study_tests(agent, room, settings)
     assert len(tests) == 3 * 2 * 3 and set(tests["strategy"]) <= {"hand", "tool", "vocal"}
     assert (np.hypot(tests["x"], tests["y"]) <= 1.0).all() and np.isfinite(tests["error"]).all()
-    reference = random_reference(room, settings)
+    reference = random_reference({"kinematic": config}, settings, workers=1)["kinematic"]
     assert len(reference) == 3 * 9 and np.isfinite(reference["error"]).all()
     summary = study_summary(tests, reference)
     assert set(summary["competence"]) == {"all", "ring1", "ring2", "ring3"}

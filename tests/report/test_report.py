@@ -21,6 +21,7 @@ from page_checks import check_explained
 from summary_checks import check_summary
 
 from experiments.analysis.curves import curve_rows, tool_numbers
+from experiments.analysis.log_chunks import CHUNK_IDENTITY_KEY, trial_identity
 from experiments.analysis.results import ReportError, collect
 from experiments.analysis.stats import (
     chi_square,
@@ -357,6 +358,11 @@ def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
         config = json.loads(config_path.read_text())
         config["trial"]["grasp"] = "<script>alert(1)</script>"
         config_path.write_text(json.dumps(config))
+        # Log chunks carry their trial's identity: this trial's chunks take the new one.
+        for chunk in config_path.parent.glob("log/*/*.parquet"):
+            table = pd.read_parquet(chunk)
+            table.attrs[CHUNK_IDENTITY_KEY] = trial_identity(config)
+            table.to_parquet(chunk)
     text = write_report(batch, tmp_path / "out", measures=room_measures(20)).read_text()
     assert "<script>" not in text and "<b>batch" not in text
     assert "this batch: &lt;script&gt;alert(1)&lt;/script&gt;" in text

@@ -23,6 +23,11 @@ from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict, world_prese
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 
 NAN, INF = float("nan"), float("inf")
+# The bounds the messages name: distances within the room, periods within an int64, noise within
+# the motor range.
+ROOM = r"\(0, 3.7\]"
+PERIODS = r"\[1, 2\*\*63 - 1\]"
+SIGMA = r"\[0, 2.0\]"
 
 # (world setting, value, what the message must say): the issue's examples, and their kin.
 BAD_WORLD = [
@@ -30,26 +35,43 @@ BAD_WORLD = [
     ("catch_rule", "Study", "catch_rule must be one of 'study', 'held_stick'"),
     ("dmp", "studdy", "dmp must be one of 'study', 'project'"),
     ("stick_return", "sometimes", "stick_return must be one of 'never', 'out_of_reach'"),
-    ("grasp_distance", NAN, "grasp_distance must be a finite number > 0, got nan"),
-    ("grasp_distance", INF, "grasp_distance must be a finite number > 0, got inf"),
-    ("grasp_distance", -1, "grasp_distance must be a finite number > 0, got -1"),
-    ("grasp_distance", "0.1", "grasp_distance must be a finite number > 0, got '0.1'"),
-    ("catch_distance", True, "catch_distance must be a finite number > 0, got True"),
+    ("grasp_distance", NAN, rf"grasp_distance must be a finite number in {ROOM}, got nan"),
+    ("grasp_distance", INF, rf"grasp_distance must be a finite number in {ROOM}, got inf"),
+    ("grasp_distance", -1, rf"grasp_distance must be a finite number in {ROOM}, got -1"),
+    ("grasp_distance", "0.1", rf"grasp_distance must be a finite number in {ROOM}, got '0.1'"),
+    ("catch_distance", True, rf"catch_distance must be a finite number in {ROOM}, got True"),
     ("caregiver_bring_rate", 0.0, r"caregiver_bring_rate must be a finite number in \(0, 1\]"),
     ("caregiver_bring_rate", 1.5, r"caregiver_bring_rate must be a finite number in \(0, 1\]"),
-    ("toy_replace_period", 0, "toy_replace_period must be an integer >= 1, got 0"),
-    ("toy_replace_period", 20.0, "toy_replace_period must be an integer >= 1, got 20.0"),
-    ("toy_replace_period", True, "toy_replace_period must be an integer >= 1, got True"),
-    ("segment_lengths", [0.25, 0.15], "segment_lengths must be 3 finite numbers > 0"),
-    ("segment_lengths", [0.25, 0.15, -0.1], "segment_lengths must be 3 finite numbers > 0"),
-    ("stick_start_handle", [-0.25, NAN], "stick_start_handle must be 2 finite numbers"),
+    ("toy_replace_period", 0, rf"toy_replace_period must be an integer in {PERIODS}, got 0"),
+    ("toy_replace_period", 20.0, rf"toy_replace_period must be an integer in {PERIODS}, got 20.0"),
+    ("toy_replace_period", True, rf"toy_replace_period must be an integer in {PERIODS}, got True"),
+    ("segment_lengths", [0.25, 0.15], rf"segment_lengths must be 3 finite numbers in {ROOM}"),
+    ("segment_lengths", [0.25, 0.15, -0.1], rf"segment_lengths must be 3 finite numbers in {ROOM}"),
+    (
+        "stick_start_handle",
+        [-0.25, NAN],
+        r"stick_start_handle must be 2 finite numbers in \[-1.3, 1.3\]",
+    ),
     ("toy_rings", [[0, 0.5], [0.5, 0.75]], "toy_rings must be 3 .low, high. pairs"),
     ("toy_rings", [[0, 0.5], [0.75, 0.5], [0.75, 1]], "toy_rings must be 3 .low, high. pairs"),
-    ("dmp_weight_scale", 0, "dmp_weight_scale must be a finite number > 0"),
+    ("dmp_weight_scale", 0, r"dmp_weight_scale must be a finite number in \(0, 30000\]"),
     # None (the contact limit) or a distance: never 0, a string or not finite.
-    ("stick_return_reach", 0, "stick_return_reach must be a finite number > 0, got 0"),
-    ("stick_return_reach", "0.53", "stick_return_reach must be a finite number > 0, got '0.53'"),
-    ("stick_return_reach", INF, "stick_return_reach must be a finite number > 0, got inf"),
+    ("stick_return_reach", 0, rf"stick_return_reach must be a finite number in {ROOM}, got 0"),
+    (
+        "stick_return_reach",
+        "0.53",
+        rf"stick_return_reach must be a finite number in {ROOM}, got '0.53'",
+    ),
+    ("stick_return_reach", INF, rf"stick_return_reach must be a finite number in {ROOM}, got inf"),
+    # No upper bounds before (issue 31): each of these ran to its end.
+    ("grasp_distance", 1e308, rf"grasp_distance must be a finite number in {ROOM}, got 1e\+308"),
+    ("catch_distance", 4.0, rf"catch_distance must be a finite number in {ROOM}, got 4.0"),
+    ("dmp_weight_scale", 1e308, r"dmp_weight_scale must be a finite number in \(0, 30000\]"),
+    ("toy_replace_period", 99999999999999999999999, rf"toy_replace_period must be .* in {PERIODS}"),
+    ("caregiver_box", 2.0, r"caregiver_box must be a finite number in \(0, 1.3\], got 2.0"),
+    ("stick_start_handle", [-0.25, 1e308], r"stick_start_handle must be 2 finite numbers in"),
+    ("toy_rings", [[0, 0.5], [0.5, 0.75], [0.75, 1e308]], r"toy_rings .* high <= 3.7"),
+    ("stick_return_reach", 1e308, rf"stick_return_reach must be a finite number in {ROOM}"),
 ]
 
 BAD_LEARNER = [
@@ -57,12 +79,25 @@ BAD_LEARNER = [
     ("storing_rule", "moved", "storing_rule must be one of"),
     ("clip_sensory", 1, "clip_sensory must be true or false, got 1"),
     ("clip_sensory", "false", "clip_sensory must be true or false"),
-    ("exploration_sigma", "0.1", "exploration_sigma must be a finite number >= 0, got '0.1'"),
-    ("exploration_sigma", INF, "exploration_sigma must be a finite number >= 0, got inf"),
+    (
+        "exploration_sigma",
+        "0.1",
+        rf"exploration_sigma must be a finite number in {SIGMA}, got '0.1'",
+    ),
+    ("exploration_sigma", INF, rf"exploration_sigma must be a finite number in {SIGMA}, got inf"),
     ("imitation_share", NAN, r"imitation_share must be a finite number in \[0, 1\]"),
-    ("outcomes_to_infer", 2.0, "outcomes_to_infer must be an integer >= 1, got 2.0"),
-    ("bootstrap_arm", True, "bootstrap_arm must be an integer >= 0, got True"),
-    ("motor_high", NAN, "motor_high must be a finite number, got nan"),
+    ("outcomes_to_infer", 2.0, rf"outcomes_to_infer must be an integer in {PERIODS}, got 2.0"),
+    ("bootstrap_arm", True, r"bootstrap_arm must be an integer in \[0, 10000000\], got True"),
+    ("motor_high", NAN, r"motor_high must be a finite number in \[-1, 1\], got nan"),
+    ("exploration_sigma", 1e308, rf"exploration_sigma must be a finite number in {SIGMA}, got 1e"),
+    ("progress_window", 100000000000, r"progress_window must be an integer in \[1, 1000000\]"),
+    ("progress_window", 99999999999999999999, r"progress_window must be an integer in \[1, 10"),
+    ("imitation_memory", 10**9, r"imitation_memory must be an integer in \[1, 1000000\]"),
+    ("bootstrap_voice", 10**12, r"bootstrap_voice must be an integer in \[0, 10000000\]"),
+    ("outcomes_to_infer", 2**63, rf"outcomes_to_infer must be an integer in {PERIODS}"),
+    ("motor_low", -2.0, r"motor_low must be a finite number in \[-1, 1\], got -2.0"),
+    ("goal_high", 1e308, r"goal_high must be a finite number in \[-2, 2\], got 1e\+308"),
+    ("change_tolerance", 1e308, r"change_tolerance must be a finite number in \[0, 4\]"),
 ]
 
 
@@ -132,6 +167,28 @@ def test_a_trial_with_a_bad_override_is_refused_before_anything_is_written(
     with pytest.raises(TrialError, match=says) as exc:
         run_trial(out, TrialSettings(iterations=5, overrides=overrides), progress=False)
     _one_line(str(exc.value))
+    assert not out.exists()
+
+
+# The issue's examples, which ran to their end with exit code 0: (--set, setting, range).
+UNBOUNDED = [
+    ("world.grasp_distance=1e308", "grasp_distance", "(0, 3.7]"),
+    ("learner.exploration_sigma=1e308", "exploration_sigma", "[0, 2.0]"),
+    ("world.dmp_weight_scale=1e308", "dmp_weight_scale", "(0, 30000]"),
+    ("world.toy_replace_period=99999999999999999999999", "toy_replace_period", "[1, 2**63 - 1]"),
+]
+
+
+@pytest.mark.parametrize(("given", "name", "allowed"), UNBOUNDED)
+def test_a_setting_beyond_its_range_is_one_line_naming_it_its_value_and_range(
+    tmp_path, capsys, given, name, allowed
+):
+    out = tmp_path / "t"
+    assert main(["run", "--out", str(out), "--iterations", "5", "--quiet", "--set", given]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    value = repr(json.loads(given.split("=")[1]))
+    assert len(err) == 1 and f"{name} must be" in err[0], err
+    assert f"in {allowed}, got {value}" in err[0], err[0]
     assert not out.exists()
 
 

@@ -58,10 +58,12 @@ class TestMovementEnvIsADmEnv(test_utils.EnvironmentTestMixin, unittest.TestCase
 
 
 def _checked_quietly(env: gymnasium.Env) -> None:
-    # Gymnasium's checker warns about what it only recommends: here every warning fails.
+    # Gymnasium's checker warns about what it only recommends: here every warning fails. Its
+    # render check makes the environment in each declared mode, "human" included, which needs a
+    # display: tests/world/test_env_rendering.py runs it whole under Xvfb, and checks the frames.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        check_env(env)
+        check_env(env, skip_render_check=True)
 
 
 def test_gym_env_passes_gymnasiums_checker_through_make():
@@ -201,9 +203,12 @@ def test_dm_env_refuses_bad_actions_in_one_line_and_nothing_moves(action, messag
     ("action", "message"),
     [
         (np.zeros(49), "shape \\(50,\\)"),
-        (np.r_[np.nan, np.zeros(49)], "NaN or inf at indices \\[0\\]"),
-        (np.r_[np.zeros(49), 2.0], "must lie in \\[-1, 1\\]"),
-        ("left", "50 numbers"),
+        (np.r_[np.nan, np.zeros(49)], "NaN or inf at indices \\[0 \\(nan\\)\\]$"),
+        (
+            np.r_[np.zeros(49), 2.0],
+            "must lie in \\[-1, 1\\], outside at indices \\[49 \\(2.0\\)\\]",
+        ),
+        ("left", "50 real numbers in \\[-1, 1\\], got str"),
     ],
 )
 def test_gym_env_refuses_actions_outside_its_space(action, message):
@@ -212,6 +217,69 @@ def test_gym_env_refuses_actions_outside_its_space(action, message):
     with pytest.raises(ValueError, match=message):
         env.step(action)
     assert env.movement_env.room.iteration == 0
+
+
+def _as_dm_action(flat: np.ndarray) -> dict:
+    """The dm_env action of a flat Gymnasium one, both commands given."""
+    arm = flat.dtype.kind == "f" and flat[0] < 0
+    return {"motor_space": 0 if arm else 1, "arm": flat[1:22], "voice": flat[22:50]}
+
+
+# Both forms share one check (sim/envs/actions.py): the same values refused with the same words.
+@pytest.mark.parametrize(
+    ("flat", "message"),
+    [
+        # NumPy would drop the imaginary part with a ComplexWarning, or read True as 1.0.
+        (np.zeros(50, dtype=complex), "real numbers in \\[-1, 1\\], got an array of complex128"),
+        (np.zeros(50, dtype=bool), "real numbers in \\[-1, 1\\], got an array of bool"),
+        (np.array([0.0] * 49 + [None]), "real numbers in \\[-1, 1\\], got an array of object"),
+        (np.array(["0"] * 50), "real numbers in \\[-1, 1\\], got an array of <U1"),
+        # The arm is chosen: a NaN in the voice's command is refused all the same.
+        (
+            np.r_[-1.0, np.zeros(21), np.nan, np.zeros(27)],
+            "NaN or inf at indices \\[\\d+ \\(nan\\)\\]$",
+        ),
+        # The exact value, not a rounding of it that reads as inside the range.
+        (np.r_[-1.0, -1.0000001, np.zeros(48)], "outside at indices \\[\\d+ \\(-1.0000001\\)\\]$"),
+        # A few indices, then how many more.
+        (
+            np.r_[-1.0, np.full(49, np.inf)],
+            "\\[(\\d+ \\(inf\\), ){4}\\d+ \\(inf\\)\\] and \\d+ more$",
+        ),
+    ],
+)
+def test_both_environments_refuse_the_same_actions_in_the_same_words(flat, message):
+    gym = PlayroomGymEnv(iterations=10)
+    gym.reset(seed=0)
+    dm = PlayroomMovementEnv(iterations=10)
+    dm.reset(seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a ComplexWarning is no refusal
+        with pytest.raises(ValueError, match=message):
+            gym.step(flat)
+        with pytest.raises(ValueError, match=message):
+            dm.step(_as_dm_action(flat))
+    assert gym.movement_env.room.iteration == dm.room.iteration == 0
+
+
+def test_the_index_lists_of_the_two_forms_count_within_their_own_arrays():
+    action = np.r_[1.0, np.zeros(21), np.full(28, np.nan)]
+    gym = PlayroomGymEnv(iterations=10)
+    gym.reset(seed=0)
+    with pytest.raises(ValueError) as caught:
+        gym.step(action)
+    assert str(caught.value) == (
+        "the action contains NaN or inf at indices [22 (nan), 23 (nan), 24 (nan), 25 (nan), "
+        "26 (nan)] and 23 more"
+    )
+    dm = PlayroomMovementEnv(iterations=10)
+    dm.reset(seed=0)
+    with pytest.raises(ValueError) as caught:
+        dm.step(_as_dm_action(action))
+    assert str(caught.value) == (
+        "the voice command contains NaN or inf at indices [0 (nan), 1 (nan), 2 (nan), 3 (nan), "
+        "4 (nan)] and 23 more"
+    )
 
 
 @pytest.mark.parametrize(
@@ -229,9 +297,15 @@ def test_bad_settings_are_refused_in_one_line(kwargs, message):
         PlayroomMovementEnv(**kwargs)
 
 
-def test_gym_env_refuses_render_modes_reset_options_and_bad_seeds():
-    with pytest.raises(ValueError, match="renders nothing"):
-        PlayroomGymEnv(render_mode="human")
+def test_gym_env_refuses_unknown_render_modes_reset_options_and_bad_seeds():
+    with pytest.raises(
+        ValueError, match="unknown render_mode 'ansi': one of \\['human', 'rgb_array'\\]"
+    ):
+        PlayroomGymEnv(render_mode="ansi")
+    with pytest.raises(ValueError, match="unknown camera 'side'"):
+        PlayroomGymEnv(render_mode="rgb_array", camera="side")
+    with pytest.raises(ValueError, match="render_size 2000x100 is outside"):
+        PlayroomGymEnv(render_mode="rgb_array", render_size=(2000, 100))
     env = PlayroomGymEnv(iterations=10)
     with pytest.raises(ValueError, match="no options"):
         env.reset(options={"toys": 1})

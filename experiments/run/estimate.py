@@ -1,0 +1,154 @@
+"""What a trial will cost, said before it starts: its time, and the disk its files take.
+
+The disk a trial holds at its end grows with its iterations: a row of logs each, and the
+learner's memory, which every checkpoint holds (two are kept). Its time and the bytes it writes
+grow faster, with the square of the iterations: the memory's nearest-neighbour query scans one
+more row each iteration, and every checkpoint rewrites all the rows. So a trial ten times the
+study's length costs about a hundred times its time, and a billion iterations decades.
+
+The estimate rests on the costs measured on the development machine (README, its bench figures
+at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
+measured. Another machine scales the time, not the disk. A trial that will not fit on its disk
+is refused before anything is written, `--quiet` or not (`check_fits`).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from experiments import storage
+from experiments.file_names import CHECKPOINT_FILE, LOG_DIR, PREVIOUS_CHECKPOINT_FILE
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_files import TrialError
+
+# Seconds of an iteration, by grasp backend: 5293 and 559 iterations a second over trials of
+# 5000 iterations (README, `playroom bench trial`).
+SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
+# The inverse query scans the chosen model's rows, at most one per iteration so far: 77 us at
+# 80000 rows (README, `playroom bench learner`), in proportion to them.
+QUERY_SECONDS_PER_ROW = 77e-6 / 80000
+# Bytes an iteration adds to the logs (README: about 120 KB per 1000 iterations) and to each
+# checkpoint (586 measured at 20000 kinematic iterations; 611 in issue 31: 416 MB at 681000).
+LOG_BYTES_PER_ITERATION = 120
+CHECKPOINT_BYTES_PER_ITERATION = 620
+# How fast a checkpoint is written: an 11 MB one took 19 to 23 ms.
+CHECKPOINT_BYTES_PER_SECOND = 0.5e9
+# Trials longer than the study's 80000 iterations state their estimate before they start.
+LONG_TRIAL = 80000
+
+
+@dataclass(frozen=True)
+class TrialCosts:
+    """What running a trial from an iteration to its end costs."""
+
+    seconds: float
+    disk_bytes: float  # its logs and two checkpoints at the end
+    written_bytes: float  # every checkpoint written on the way, in all
+
+
+def trial_costs(settings: TrialSettings, start: int = 0) -> TrialCosts:
+    """The costs of running `settings`' trial from iteration `start` to its end."""
+    n, s = settings.iterations, min(start, settings.iterations)
+    # The rows scanned over iterations s..n-1, about sum(i) = (n^2 - s^2) / 2; the checkpoint
+    # at iteration k holds k iterations' rows, one every `checkpoint_every`, and one at the end.
+    rows = (n * n - s * s) / 2
+    written = CHECKPOINT_BYTES_PER_ITERATION * (rows / settings.checkpoint_every + (n - s))
+    seconds = (
+        (n - s) * _per_iteration(settings.grasp)
+        + rows * QUERY_SECONDS_PER_ROW
+        + written / CHECKPOINT_BYTES_PER_SECOND
+    )
+    disk = n * (LOG_BYTES_PER_ITERATION + 2 * CHECKPOINT_BYTES_PER_ITERATION)
+    return TrialCosts(seconds, disk, written)
+
+
+def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | None:
+    """TrialError (one line) if the trial's files will not fit on the disk of `out_dir`, with
+    what it holds there already; else the line that states a long trial's costs (trials longer
+    than LONG_TRIAL iterations, with iterations left to run), or None."""
+    start, held = _progress(out_dir) if resume else (0, 0)
+    costs = trial_costs(settings, start)
+    free = _free_space(_existing(out_dir))
+    need = costs.disk_bytes - held
+    basis = (
+        f"estimated from the development machine's costs: "
+        f"{1000 * _per_iteration(settings.grasp):.2g} ms an iteration, "
+        f"plus {1e9 * QUERY_SECONDS_PER_ROW:.2g} ns per row of memory searched, "
+        f"{LOG_BYTES_PER_ITERATION} B of logs and {CHECKPOINT_BYTES_PER_ITERATION} B per "
+        "checkpoint an iteration"
+    )
+    if free is not None and need > free:
+        raise TrialError(
+            f"this trial needs ~{size(need)} more of logs and checkpoints on {out_dir} "
+            f"({size(free)} free): ask for fewer iterations, or another disk ({basis})"
+        )
+    if settings.iterations <= LONG_TRIAL or start >= settings.iterations:
+        return None
+    free_text = "?" if free is None else size(free)
+    return (
+        f"this trial: ~{duration(costs.seconds)}, ~{size(costs.disk_bytes)} of logs and "
+        f"checkpoints on {out_dir} ({free_text} free); its checkpoints, each rewriting every "
+        f"row, write ~{size(costs.written_bytes)} in all ({basis})"
+    )
+
+
+def _per_iteration(grasp: str) -> float:
+    """Seconds of an iteration of a backend; a backend not measured yet, the slowest's."""
+    return SECONDS_PER_ITERATION.get(grasp, max(SECONDS_PER_ITERATION.values()))
+
+
+def _progress(out_dir: Path) -> tuple[int, int]:
+    """(iteration of the newest readable checkpoint, bytes of checkpoints and logs) of a trial
+    to be resumed; (0, 0) where there is none yet. A resume checks the trial itself."""
+    iteration = 0
+    for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
+        try:
+            iteration = int(storage.read_meta(out_dir / name)["iteration"])
+            break
+        except (storage.CorruptFileError, KeyError, TypeError, ValueError):
+            continue
+    files = [out_dir / CHECKPOINT_FILE, out_dir / PREVIOUS_CHECKPOINT_FILE]
+    files += [p for p in (out_dir / LOG_DIR).rglob("*") if p.is_file()]
+    return iteration, sum(p.stat().st_size for p in files if p.is_file())
+
+
+def _free_space(folder: Path) -> int | None:
+    """Bytes free for files in `folder`; None where the system cannot say or nothing can be
+    written (a pseudo file system such as /proc, a read-only one): the directory's own checks
+    then say what is wrong."""
+    usage = shutil.disk_usage(folder)
+    if usage.total == 0 or not os.access(folder, os.W_OK):
+        return None
+    return usage.free
+
+
+def _existing(path: Path) -> Path:
+    """`path`, or its nearest parent that exists: where its files would go."""
+    path = Path(os.path.abspath(path))
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
+def size(n_bytes: float) -> str:
+    """'96 MB', '1.36 TB': decimal units, three significant digits."""
+    for unit, scale in (("PB", 1e15), ("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("KB", 1e3)):
+        if n_bytes >= scale:
+            return f"{_number(n_bytes / scale)} {unit}"
+    return f"{n_bytes:.0f} B"
+
+
+def duration(seconds: float) -> str:
+    """'40 s', '12 min', '3.2 h', '5.1 days', '35 years'."""
+    for unit, scale in (("years", 365.25 * 86400), ("days", 86400), ("h", 3600), ("min", 60)):
+        if seconds >= 2 * scale:
+            return f"{_number(seconds / scale)} {unit}"
+    return f"{_number(seconds)} s"
+
+
+def _number(value: float) -> str:
+    """Three significant digits, without an exponent: '1.36', '35', '1200'."""
+    return f"{value:.3g}" if value < 1000 else f"{value:.0f}"

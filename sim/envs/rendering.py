@@ -1,0 +1,178 @@
+"""Frames of the room for the Gymnasium environment's render modes: "rgb_array" with MuJoCo's
+offscreen renderer, "human" in MuJoCo's passive viewer.
+
+The offscreen backend is chosen as for videos (experiments/video/gl.py, which sim cannot
+import): the one `MUJOCO_GL` names, EGL when it is unset. MuJoCo picks its own GL context class
+once, when first imported (GLFW with `MUJOCO_GL` unset, which needs a display), so the
+renderer makes its context from the chosen backend's module itself: an environment whose
+room was built before anything rendered still renders offscreen. A backend's module is
+imported on the first render: an environment that never renders loads no GL library of its
+own (MuJoCo loads what `MUJOCO_GL` names at its import, nothing under `disable`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import threading
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from sim import GL_VARIABLE, environment_kept, gl_library_problem
+
+BACKENDS = ("egl", "osmesa", "glfw")
+DEFAULT_BACKEND = "egl"
+DEFAULT_SIZE = (640, 480)  # width, height (px), as videos
+CAMERAS = ("top", "hand_view")  # models/playroom.xml
+# How long closing the viewer waits for its window's thread (GLFW would pull the window from
+# under a running thread at exit: a segmentation fault).
+VIEWER_CLOSE_WAIT_S = 10.0
+
+
+class RenderError(RuntimeError):
+    """The room cannot be rendered here; the message says why and what to set, in one line."""
+
+
+def backend() -> str:
+    """The offscreen backend: MUJOCO_GL's value, else EGL; RenderError for one that cannot
+    render offscreen (MUJOCO_GL=disable included)."""
+    chosen = os.environ.get(GL_VARIABLE, "").strip().lower() or DEFAULT_BACKEND
+    if chosen not in BACKENDS:
+        raise RenderError(
+            f"{GL_VARIABLE}={chosen!r} cannot render: set it to one of {', '.join(BACKENDS)}, "
+            f"or unset it ({DEFAULT_BACKEND})"
+        )
+    return chosen
+
+
+def context_class() -> Any:
+    """The GL context class of the chosen backend (mujoco.egl.GLContext, ...), its module
+    imported if MuJoCo chose another; RenderError in one line if it cannot be loaded."""
+    chosen = backend()
+    problem = gl_library_problem(chosen)
+    if problem is not None:
+        raise RenderError(problem)
+    loaded = getattr(mujoco, "GLContext", None)
+    if loaded is not None and loaded.__module__.split(".")[1] == chosen:
+        return loaded
+    try:
+        # mujoco.egl and mujoco.osmesa set PYOPENGL_PLATFORM for PyOpenGL, which reads it once,
+        # at this import: put back, as sim sets no environment variable.
+        with environment_kept():
+            module = importlib.import_module(f"mujoco.{chosen}")
+    except Exception as exc:  # PyOpenGL raises ImportError, AttributeError, OSError, ...
+        raise RenderError(
+            f"the OpenGL backend {GL_VARIABLE}={chosen} cannot be loaded "
+            f"({type(exc).__name__}: {exc}); set {GL_VARIABLE} to one of {', '.join(BACKENDS)}"
+        ) from None
+    return module.GLContext
+
+
+def checked_view(model: Any, size: tuple[int, int], camera: str) -> tuple[int, int]:
+    """(width, height) of a frame, checked against the model's cameras and offscreen buffer;
+    ValueError in one line."""
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
+        raise ValueError(f"unknown camera {camera!r}: choose one of {list(CAMERAS)}")
+    try:
+        width, height = (int(side) for side in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"render_size must be (width, height) in px, got {size!r}") from None
+    limit = (model.vis.global_.offwidth, model.vis.global_.offheight)
+    if not (0 < width <= limit[0] and 0 < height <= limit[1]):
+        raise ValueError(
+            f"render_size {width}x{height} is outside the model's offscreen buffer "
+            f"{limit[0]}x{limit[1]} (<visual><global offwidth offheight> in the MJCF)"
+        )
+    return width, height
+
+
+class OffscreenRenderer:
+    """RGB frames (height, width, 3) uint8 of a model's state from one of its cameras, in a GL
+    context of its own (what mujoco.Renderer does, with the context chosen here). Close it: an
+    EGL context left to the garbage collector at exit prints errors."""
+
+    def __init__(
+        self, model: Any, size: tuple[int, int] = DEFAULT_SIZE, camera: str = "top"
+    ) -> None:
+        self.width, self.height = checked_view(model, size, camera)
+        self.model = model
+        context = context_class()
+        try:
+            self._context = context(self.width, self.height)
+            self._context.make_current()
+            self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150)
+        except Exception as exc:  # a driver that loads but cannot make a context
+            raise RenderError(
+                f"cannot create an offscreen GL context with {GL_VARIABLE}={backend()} "
+                f"({type(exc).__name__}: {exc}); set {GL_VARIABLE} to one of {', '.join(BACKENDS)}"
+            ) from None
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
+        self._scene = mujoco.MjvScene(model, maxgeom=1000)
+        self._option = mujoco.MjvOption()
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._camera.fixedcamid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        self._rect = mujoco.MjrRect(0, 0, self.width, self.height)
+
+    def render(self, data: Any) -> np.ndarray:
+        """The frame of `data` (an MjData of the model) as it is now."""
+        if self._mjr is None:
+            raise RuntimeError("the renderer is closed")
+        self._context.make_current()
+        mujoco.mjv_updateScene(
+            self.model, data, self._option, None, self._camera, mujoco.mjtCatBit.mjCAT_ALL,
+            self._scene,
+        )  # fmt: skip
+        # No shadows, as in videos: on Mesa's software EGL they halve the frame rate, and from
+        # the top camera they wash out the table.
+        self._scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+        mujoco.mjr_render(self._rect, self._scene, self._mjr)
+        frame = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        mujoco.mjr_readPixels(frame, None, self._rect, self._mjr)
+        return np.flipud(frame).copy()  # OpenGL's rows run bottom-up
+
+    def close(self) -> None:
+        if self._mjr is not None:
+            self._context.make_current()
+            self._mjr.free()
+            self._mjr = None
+            self._context.free()
+
+
+def display_missing() -> str | None:
+    """Why the viewer cannot open a window here, in one line; None where a display exists."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return None
+    return (
+        "render_mode 'human' opens MuJoCo's viewer, which needs a display (neither DISPLAY nor "
+        "WAYLAND_DISPLAY is set); use render_mode='rgb_array' on a machine without one"
+    )
+
+
+class Viewer:
+    """MuJoCo's passive viewer of one model and its data, shown as it is at each `show`."""
+
+    def __init__(self, model: Any, data: Any) -> None:
+        missing = display_missing()
+        if missing is not None:
+            raise RenderError(missing)
+        import mujoco.viewer
+
+        before = set(threading.enumerate())
+        self._handle = mujoco.viewer.launch_passive(
+            model, data, show_left_ui=False, show_right_ui=False
+        )
+        self._threads = set(threading.enumerate()) - before
+
+    def show(self) -> None:
+        self._handle.sync()
+
+    def is_running(self) -> bool:
+        return bool(self._handle.is_running())
+
+    def close(self) -> None:
+        self._handle.close()
+        for thread in self._threads:
+            thread.join(VIEWER_CLOSE_WAIT_S)
