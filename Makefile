@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison ablations clean
+.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations ablations clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -71,6 +71,26 @@ comparison: $(INSTALLED)
 	$(BIN)/playroom batch --profile comparison --out $(OUT)/comparison
 	$(BIN)/playroom compare $(OUT)/comparison $(OUT)/comparison --out $(OUT)/comparison-report
 
+## comparison-diva: both backends with the study's vocal tract, DIVA, at the study's scale (the
+## comparison-diva profile: 64 seeds x 80000 each, study preset) and their comparison page;
+## needs DIVA's data (`playroom voice-data diva PATH`); hours on 2 cores, resumes
+comparison-diva: $(INSTALLED)
+	$(BIN)/playroom batch --profile comparison-diva --out $(OUT)/comparison-diva
+	$(BIN)/playroom compare $(OUT)/comparison-diva $(OUT)/comparison-diva \
+		--out $(OUT)/comparison-diva-report
+
+## contact-ablations: each switch of experiments/batches/contact-ablations/ on the physical
+## backend with DIVA (32 seeds x 80000), against the same seeds of comparison-diva's physical
+## trials (`playroom ablations`)
+CONTACT_ABLATIONS := $(basename $(notdir $(wildcard experiments/batches/contact-ablations/*.json)))
+contact-ablations: comparison-diva
+	for name in $(CONTACT_ABLATIONS); do \
+		$(BIN)/playroom batch --config experiments/batches/contact-ablations/$$name.json \
+			--out $(OUT)/contact-ablation-$$name || exit 1; \
+	done
+	$(BIN)/playroom ablations $(OUT)/comparison-diva \
+		$(addprefix $(OUT)/contact-ablation-,$(CONTACT_ABLATIONS)) --out $(OUT)/contact-ablations
+
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the
 ## project preset), 32 seeds x 80000 each, then both tables (`playroom ablations`)
@@ -101,9 +121,18 @@ test: lint
 # experiments/bench/cpu_classes.py, which `playroom bench emulated` uses too.
 OTHER_CPU = $(shell $(BIN)/python -m experiments.bench.cpu_classes)
 
-## test-slow: the longer checks marked `slow`, then the whole suite with another CPU emulated
-test-slow: $(INSTALLED)
-	$(PYTEST) -m slow
+# The `rl` extra (stable-baselines3, which brings torch) for the slow checks of sim/envs/ in a
+# real reinforcement-learning library; `make test` never installs it.
+RL_INSTALLED := $(VENV)/.installed-rl
+
+$(RL_INSTALLED): $(INSTALLED)
+	$(BIN)/python -m pip install --quiet --constraint $(LOCK) -e ".[rl]"
+	touch $(RL_INSTALLED)
+
+## test-slow: the longer checks marked `slow` (with the `rl` extra installed: those checks fail
+## rather than skip without it), then the whole suite with another CPU emulated
+test-slow: $(RL_INSTALLED)
+	PLAYROOM_RL_REQUIRED=1 $(PYTEST) -m slow
 	env $(OTHER_CPU) $(PYTEST)
 
 ## lint: ruff's checks and format, mypy on the packages ([tool.mypy] in pyproject.toml;

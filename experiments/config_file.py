@@ -17,6 +17,7 @@ ADDED_SETTINGS: dict[str, object] = {
     "trial.voice": "vtl",
     "world.voice": "vtl",
     "world.stick_return_reach": None,
+    "world.push_objects": True,
 }
 
 

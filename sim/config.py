@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from models.checks import (
+    INT64_MAX,
     check_choice,
     check_int,
     check_number,
@@ -30,6 +31,21 @@ DMP_KINDS = ("study", "project")  # sim/dmp.py
 CATCH_RULES = ("study", "held_stick")  # sim/grasping/kinematic.py
 STICK_RETURNS = ("never", "out_of_reach")  # sim/experimenter.py
 N_RINGS = 3  # the study's rings; evaluations and reports name them ring1..ring3
+# With push_objects off: the table damping of an unheld object (20 on x, y in the MJCF) times
+# this. At 1e4 no random arm command of 600 moved an unheld object by 1 mm (MOVED_DISTANCE),
+# against 112 pushes at 1 (seed 3, study preset); grasps and catches went on as before.
+UNPUSHED_DAMPING_FACTOR = 1e4
+
+# The room's scale, which bounds every length and position setting (m). The table of
+# models/playroom.xml is 2.6 m square about the arm's base: a position on it lies within its
+# half width, and no two points of it are farther apart than its diagonal, 3.68 m.
+TABLE_HALF_WIDTH = 1.3
+ROOM_SPAN = 3.7
+# Above this scale, DMP weights in [-1, 1] are all or nothing. At the default 300, a weight of 1
+# already carries a joint or an articulator 1.1 to 1.5 times to the bound its trajectory is
+# clipped to (sim/dmp.py); at 100 times that, a weight of 0.01 does, and the clip flattens
+# nearly every command.
+DMP_WEIGHT_SCALE_MAX = 30000
 
 
 @dataclass(frozen=True)
@@ -70,6 +86,11 @@ class WorldConfig:
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
     # D13).
     voice: str = DEFAULT_TRACT
+    # Ablation of pushing (issue 32, docs/comparison.md), never a default: False holds every
+    # object that nothing holds where it lies (the physical backend multiplies its table
+    # damping by UNPUSHED_DAMPING_FACTOR), so that, as in the kinematic rules, only a grasp, a
+    # catch or the caregiver moves an object. The kinematic backend never pushes.
+    push_objects: bool = True
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a
@@ -77,23 +98,29 @@ class WorldConfig:
         for name in ("segment_lengths", "stick_start_handle", "toy_rings"):
             object.__setattr__(self, name, tuples(getattr(self, name)))  # JSON gives lists
         w = "WorldConfig."
-        check_numbers(w + "segment_lengths", self.segment_lengths, 3, "(0, inf)")
+        lengths, positions = f"(0, {ROOM_SPAN}]", f"[-{TABLE_HALF_WIDTH}, {TABLE_HALF_WIDTH}]"
+        check_numbers(w + "segment_lengths", self.segment_lengths, 3, lengths)
         check_number(w + "arm_rest_offset", self.arm_rest_offset)
         check_choice(w + "dmp", self.dmp, DMP_KINDS)
-        check_number(w + "dmp_weight_scale", self.dmp_weight_scale, "(0, inf)")
-        check_number(w + "stick_length", self.stick_length, "(0, inf)")
-        check_numbers(w + "stick_start_handle", self.stick_start_handle, 2)
+        check_number(w + "dmp_weight_scale", self.dmp_weight_scale, f"(0, {DMP_WEIGHT_SCALE_MAX}]")
+        check_number(w + "stick_length", self.stick_length, lengths)
+        check_numbers(w + "stick_start_handle", self.stick_start_handle, 2, positions)
         check_number(w + "stick_start_angle", self.stick_start_angle)
-        check_int(w + "toy_replace_period", self.toy_replace_period, minimum=1)
+        # A period longer than any trial never places a toy: allowed, up to what an int64 holds.
+        check_int(w + "toy_replace_period", self.toy_replace_period, 1, INT64_MAX)
         _check_rings(w + "toy_rings", self.toy_rings)
-        for name in ("caregiver_box", "grasp_distance", "catch_distance"):
-            check_number(w + name, getattr(self, name), "(0, inf)")
+        # The caregiver stands on the table, within [-box, box]^2.
+        check_number(w + "caregiver_box", self.caregiver_box, f"(0, {TABLE_HALF_WIDTH}]")
+        for name in ("grasp_distance", "catch_distance"):
+            check_number(w + name, getattr(self, name), lengths)
         check_choice(w + "catch_rule", self.catch_rule, CATCH_RULES)
         check_number(w + "caregiver_bring_rate", self.caregiver_bring_rate, "(0, 1]")
         check_choice(w + "stick_return", self.stick_return, STICK_RETURNS)
         if self.stick_return_reach is not None:
-            check_number(w + "stick_return_reach", self.stick_return_reach, "(0, inf)")
+            check_number(w + "stick_return_reach", self.stick_return_reach, lengths)
         check_choice(w + "voice", self.voice, TRACTS)
+        if not isinstance(self.push_objects, bool):
+            raise ValueError(f"{w}push_objects must be true or false, got {self.push_objects!r}")
 
     @property
     def arm_length(self) -> float:
@@ -102,16 +129,17 @@ class WorldConfig:
 
 
 def _check_rings(name: str, rings: Any) -> None:
-    """N_RINGS (low, high) pairs of distances from the arm's base, 0 <= low < high."""
+    """N_RINGS (low, high) pairs of distances from the arm's base, 0 <= low < high <= ROOM_SPAN."""
 
     def ring_ok(ring: Any) -> bool:
         pair = isinstance(ring, tuple) and len(ring) == 2 and all(is_number(v) for v in ring)
-        return pair and 0 <= ring[0] < ring[1]
+        return pair and 0 <= ring[0] < ring[1] <= ROOM_SPAN
 
     if not (isinstance(rings, tuple) and len(rings) == N_RINGS and all(map(ring_ok, rings))):
+        shown = repr(rings) if len(repr(rings)) <= 60 else repr(rings)[:57] + "..."
         raise ValueError(
             f"{name} must be {N_RINGS} [low, high] pairs of finite distances with "
-            f"0 <= low < high, got {rings!r}"
+            f"0 <= low < high <= {ROOM_SPAN}, got {shown}"
         )
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from models import playroom_xml
 from models.layout import TOYS
-from sim.config import DEFAULT_WORLD, WorldConfig
+from sim.config import DEFAULT_WORLD, UNPUSHED_DAMPING_FACTOR, WorldConfig
 from sim.dm_control_import import dm_mujoco
 
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
@@ -43,6 +43,12 @@ class PlayroomPhysics(dm_mujoco.Physics):
         world `config`; ValueError naming every length on which the two disagree."""
         physics = cls.from_xml_path(str(path or playroom_xml()))
         physics.config = config
+        if not config.push_objects:
+            # The ablation of pushing (WorldConfig.push_objects): the table holds an object
+            # that nothing holds. Lifting (held, carried) still clears the damping entirely
+            # (sim/model_edits.py), and the integrator treats damping implicitly, so this
+            # stays stable however large.
+            physics.model.ptr.dof_damping[physics.object_dof.ravel()] *= UNPUSHED_DAMPING_FACTOR
         mismatches = physics.disagreements_with(config)
         if mismatches:
             raise ValueError(

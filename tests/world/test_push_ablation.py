@@ -1,0 +1,44 @@
+"""The ablation of pushing (WorldConfig.push_objects, issue 32): with it off, the physical room
+moves an object only by a grasp, a catch or the caregiver, as the kinematic rules do; grasps
+and catches go on."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from experiments.config_file import identity_form, with_added_settings
+from sim import Playroom
+from sim import events as ev
+from sim.config import world_preset
+
+
+def _movers(push_objects: bool, n: int = 200) -> Counter:
+    """(event kind, by) of n random arm commands in a physical room of seed 3."""
+    config = dataclasses.replace(world_preset("study"), push_objects=push_objects)
+    room = Playroom("physical", seed=3, config=config)
+    rng = np.random.default_rng(0)
+    seen: Counter = Counter()
+    for _ in range(n):
+        for e in room.act("arm", rng.uniform(-1, 1, 21)).events:
+            if e.kind in (ev.STICK_MOVED, ev.TOY_MOVED):
+                seen[(e.kind, e.by)] += 1
+    return seen
+
+
+def test_without_pushing_only_a_grasp_or_a_catch_moves_an_object():
+    pushed, held_only = _movers(True), _movers(False)
+    assert pushed[(ev.STICK_MOVED, "push")] + pushed[(ev.TOY_MOVED, "push")] > 0
+    assert {by for _, by in held_only} <= {"hand", "stick"}
+    assert held_only[(ev.STICK_MOVED, "hand")] > 0 and held_only[(ev.TOY_MOVED, "hand")] > 0
+
+
+def test_the_switch_is_a_checked_setting_absent_from_older_trials():
+    with pytest.raises(ValueError, match="push_objects"):
+        dataclasses.replace(world_preset("study"), push_objects="no")
+    old = {"world": {"grasp_distance": 0.1}}
+    assert with_added_settings(old)["world"]["push_objects"] is True
+    assert "push_objects" not in identity_form({"world": {"push_objects": True}})["world"]
