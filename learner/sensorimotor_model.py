@@ -141,6 +141,14 @@ class SensorimotorModel:
         i, distance = self._nearest_inverse(context, goal)
         return self._motor[i].copy(), distance
 
+    def nearest_experience(
+        self, context: np.ndarray, goal: ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """The stored experience `inverse` would replay: (motor command, its context c_i, its
+        sensory block s_i, distance from (c_i, goal)), copies. ValueError if empty."""
+        i, distance = self._nearest_inverse(context, goal)
+        return self._motor[i].copy(), self.context[i].copy(), self.sensory[i].copy(), distance
+
     def inverse_command(self, context: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """`inverse`'s command alone, without computing the distance (the learning loop's
         query), from a checked context (10,) and a float64 goal (10,)."""

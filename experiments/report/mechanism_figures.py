@@ -6,6 +6,7 @@ error it got there, and the voice's social loop trial by trial."""
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
@@ -161,3 +162,52 @@ def mechanism_figures(results: BatchResults, geometry: Geometry) -> list[FigureF
     ]
     out += [(n, t, c, f) for n, t, c, f in figures if f is not None]
     return [FigureFile(name, title, caption, png_bytes(fig)) for name, title, caption, fig in out]
+
+
+def replay_figure(table: pd.DataFrame) -> Figure:
+    """Of `python -m experiments.measure.replay`'s table: per backend, the mean error the
+    remembered movement leaves in each scene, from where it was learned to the test's own,
+    against the random command on the test's scene; and the error the goal toy's shift adds
+    (test minus stick_at_start), by how far the toy lies from where it was remembered."""
+    fig = Figure(figsize=(11, 3.6), dpi=DPI, layout="constrained")
+    bars, shift = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    scenes = ("alone", "remembered", "stick_at_start", "test")
+    groups = list(dict.fromkeys(table["grasp"]))
+    width = 0.8 / len(groups)
+    edges = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4, 2.0]
+    for j, group in enumerate(groups):
+        rows = table[table["grasp"] == group]
+        colour = group_colour(groups, group)
+        x = np.arange(len(scenes)) + (j - (len(groups) - 1) / 2) * width
+        bars.bar(x, [rows[f"error_{s}"].mean() for s in scenes], width, color=colour, label=group)
+        bars.axhline(rows["random_error"].mean(), color=colour, linestyle="--")
+        added = rows["error_test"] - rows["error_stick_at_start"]
+        bins = pd.cut(rows["toy_shift"], edges)
+        means = added.groupby(bins, observed=False).mean()
+        shift.plot(np.arange(len(means)), means.to_numpy(), marker="o", color=colour, label=group)
+    bars.set_xticks(range(len(scenes)), ["alone", "remembered", "stick at\nstart", "test"])
+    bars.set_ylabel("mean error left (dashed: random command)")
+    bars.legend(fontsize=8)
+    labels = [f"{a:g}-{b:g}" for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    shift.set_xticks(range(len(labels)), labels, fontsize=8)
+    shift.set_xlabel("goal toy's distance from where the movement met it (m)")
+    shift.set_ylabel("error added by the toy's shift")
+    shift.axhline(0, color="black", linewidth=0.8)
+    shift.legend(fontsize=8)
+    return fig
+
+
+def main() -> None:
+    """`python -m experiments.report.mechanism_figures REPLAY.csv --out FIGURE.png`."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description="the replay test's figure (docs/comparison.md)")
+    parser.add_argument("table", help="the CSV of `python -m experiments.measure.replay`")
+    parser.add_argument("--out", required=True, help="the PNG to write")
+    args = parser.parse_args()
+    with open(args.out, "wb") as file:
+        file.write(png_bytes(replay_figure(pd.read_csv(args.table))))
+
+
+if __name__ == "__main__":
+    main()
