@@ -18,6 +18,7 @@ ADDED_SETTINGS: dict[str, object] = {
     "world.voice": "vtl",
     "world.stick_return_reach": None,
     "world.push_objects": True,
+    "world.settle_between_movements": False,
 }
 
 

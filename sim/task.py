@@ -187,6 +187,7 @@ class PlayroomTask(control.Task):
         """Drop everything, arm to rest, the caregiver puts down what she carries."""
         self.grasp.release(physics)
         self.caregiver.stop(physics)
+        self.grasp.settle(physics)
         self.movement = None
         self.sound[:] = 0.0
 

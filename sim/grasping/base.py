@@ -82,6 +82,10 @@ class GraspBackend(abc.ABC):
     def release(self, physics: PlayroomPhysics) -> None:
         """Drop everything where it is and put the arm back at rest."""
 
+    def settle(self, physics: PlayroomPhysics) -> None:  # noqa: B027 (a hook, most need none)
+        """Between movements, after everything is dropped: nothing to do unless the backend's
+        objects can be left overlapping (the physical one, WorldConfig.settle_between_movements)."""
+
     # The caregiver bringing a toy (sim/caregiver.py) --------------------------------------
     @abc.abstractmethod
     def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:

@@ -12,6 +12,7 @@ import numpy as np
 
 from models.layout import TOYS
 from sim import events as ev
+from sim.config import SETTLE_PHYSICS_STEPS
 from sim.grasping.base import GraspBackend, arm_to_rest
 from sim.kinematics import segment_distance
 from sim.physics import OBJECTS, PlayroomPhysics
@@ -126,6 +127,18 @@ class PhysicalGrasp(GraspBackend):
         self.hand_holds = None
         self.stick_holds = None
         self.edits.clear(self.name)
+        physics.stop_objects()
+        arm_to_rest(physics)
+
+    def settle(self, physics: PlayroomPhysics) -> None:
+        """With `settle_between_movements` (an ablation, issue 32): the room's physics runs
+        SETTLE_PHYSICS_STEPS with the arm held at rest before the next movement, so that
+        objects a release, the arm's return to rest or the caregiver's putting down left
+        overlapping part now, and not during the next movement, where a vocal movement would
+        record their parting as its toy's outcome. Then everything is still again."""
+        if not self.config.settle_between_movements:
+            return
+        physics.advance(SETTLE_PHYSICS_STEPS)
         physics.stop_objects()
         arm_to_rest(physics)
 
