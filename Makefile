@@ -115,7 +115,7 @@ PYTEST := $(BIN)/python -m pytest -q -n auto --dist loadfile
 test: lint
 	$(PYTEST)
 
-# Another x86-64 CPU class, emulated on this one (../shared/notes.md): on a CPU with AVX-512,
+# Another x86-64 CPU class, emulated on this one (docs/cpu-classes.md): on a CPU with AVX-512,
 # NumPy's AVX-512 kernels off, OpenBLAS's Haswell kernel and numba compiling for Haswell (an
 # AVX2 machine); without it, the same one class older (an AVX machine). The settings come from
 # experiments/bench/cpu_classes.py, which `playroom bench emulated` uses too.
@@ -154,7 +154,7 @@ bench: $(INSTALLED)
 
 ## voice-model: regenerate the vocal tract's articulators and fitted formant map (tens of minutes)
 voice-model: $(INSTALLED)
-	$(BIN)/python -m sim.vocal.fitting.fit_voice_model
+	$(BIN)/python -m sim.vocal.vtl.fitting.fit_voice_model
 
 clean:
 	rm -rf $(VENV) .lock-venv .pytest_cache .ruff_cache .mypy_cache

@@ -32,6 +32,9 @@ OLD_LOG_CHUNK_PATTERN = r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parque
 # (experiments/provenance.py), and where one that cannot be read is kept aside.
 PROVENANCE_FILE = "provenance.json"
 DAMAGED_PROVENANCE_FILE = "provenance.damaged.json"
+# What the trial's grasp backend declares of itself (its reach, its capabilities), written when
+# the trial first computes, for analysis to read (experiments/backend_record.py).
+BACKEND_FILE = "backend.json"
 # The lock of the directory's one writer (experiments/run/lock.py).
 LOCK_FILE = ".lock"
 TRIAL_ENTRIES = (
@@ -43,6 +46,7 @@ TRIAL_ENTRIES = (
     LOCK_FILE,
     PROVENANCE_FILE,
     DAMAGED_PROVENANCE_FILE,
+    BACKEND_FILE,
 )
 # Derived files of a shorter run, moved aside when a trial is extended.
 STALE_PREFIX = "stale-at-"

@@ -1,10 +1,15 @@
 """The caregiver (docs/protocol.md §6): where she stands, the words she uses, what she says
 after an arm movement, what she hears of the agent's voice, and how she brings a toy.
 
+Every rule of hers is written here once, whichever path computes a movement (sim/movement.py):
+what she says (`speak`), what she hears (`hear`), where she brings a toy (`target`) and how fast
+(`brought_path`, the positions of the whole way, which every path reads step by step).
+
 The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
-which word names which toy is hers, drawn once per room. How a toy she brings moves is the
-grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy, lifted
-above the table, in the physical backend; placed directly, as in the study, in the kinematic one.
+which word names which toy is hers, drawn once per room. How a toy she brings is moved along her
+path is the grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy,
+lifted above the table, in the physical backend; placed directly, as in the study, in the
+kinematic one.
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ import numpy as np
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
 from sim.config import WorldConfig
-from sim.grasping.base import GraspBackend
+from sim.grasping.base import GraspBackend, Holds
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import VoiceConfig
 from sim.vocal.voice import Voice
@@ -32,6 +37,21 @@ class WordAssignment:
     def toy_of(self, word: str) -> int | None:
         """0-based index of the toy a word names, or None for a distractor."""
         return self.names.index(word) if word in self.names else None
+
+
+def brought_path(start: np.ndarray, target: np.ndarray, rate: float) -> np.ndarray:
+    """(N_STEPS, 2) where a toy she brings is after each control step: `rate` of the remaining
+    way from `start` (2,) to `target` (2,) at every step (docs/protocol.md §6)."""
+    # The same operations on each coordinate, in Python floats (IEEE doubles, as NumPy's): a
+    # 50-step loop of 2-vector NumPy operations cost 180 us.
+    path = np.empty((N_STEPS, 2))
+    x, y = (float(v) for v in start)
+    tx, ty = (float(v) for v in target)
+    for k in range(N_STEPS):
+        x += rate * (tx - x)
+        y += rate * (ty - y)
+        path[k] = x, y
+    return path
 
 
 def assign_words(rng: np.random.Generator, config: VoiceConfig) -> WordAssignment:
@@ -57,6 +77,8 @@ class Caregiver:
         self.vocal_tract = vocal_tract
         self.words: WordAssignment = assign_words(rng, vocal_tract.config)
         self.bringing: int | None = None  # index of the toy she is bringing
+        # Where the toy she brings is after each control step of this movement, (N_STEPS, 2).
+        self.path: np.ndarray | None = None
 
     # Where she stands ----------------------------------------------------------------------
     def place(self, physics: PlayroomPhysics, rng: np.random.Generator) -> None:
@@ -72,11 +94,12 @@ class Caregiver:
         return physics.caregiver_position() / 2.0
 
     # What she says and hears ---------------------------------------------------------------
-    def speak(self, held: str | None, rng: np.random.Generator) -> tuple[np.ndarray, ev.Event]:
-        """After an arm movement: the name of the toy in the hand, else a random distractor.
-        Returns the word's sound features (10,) and the event."""
-        if held in TOYS:
-            word, obj = self.words.names[TOYS.index(held)], held
+    def speak(self, holds: Holds, rng: np.random.Generator) -> tuple[np.ndarray, ev.Event]:
+        """After an arm movement, from what the hand and the stick hold at its end: the name of
+        the toy in the hand, else a random distractor. Returns the word's sound features (10,)
+        and the event."""
+        if holds.hand in TOYS:
+            word, obj = self.words.names[TOYS.index(holds.hand)], holds.hand
         else:
             word, obj = self.words.distractors[rng.integers(len(self.words.distractors))], None
         features = self.vocal_tract.word_features(word)
@@ -98,13 +121,14 @@ class Caregiver:
     def start_bringing(self, physics: PlayroomPhysics, toy: int) -> None:
         """Take toy `toy` (0-based) and bring it over the coming control steps."""
         self.bringing = toy
-        self.backend.caregiver_takes(physics, toy)
+        start = self.backend.caregiver_takes(physics, toy)
+        self.path = brought_path(start, self.target(physics), self.config.caregiver_bring_rate)
 
-    def before_step(self, physics: PlayroomPhysics) -> None:
-        """Move the toy she is bringing `caregiver_bring_rate` of the remaining way."""
-        if self.bringing is None:
+    def before_step(self, physics: PlayroomPhysics, step: int) -> None:
+        """Control step `step` (1-based): the toy she brings to its place on her path."""
+        if self.path is None or self.bringing is None:
             return
-        self.backend.caregiver_carries(physics, self.bringing, self.target(physics))
+        self.backend.caregiver_carries(physics, self.bringing, self.path[step - 1])
 
     def stop(self, physics: PlayroomPhysics) -> None:
         """Put the toy down where it is."""
@@ -112,3 +136,4 @@ class Caregiver:
             return
         self.backend.caregiver_puts_down(physics)
         self.bringing = None
+        self.path = None

@@ -101,8 +101,7 @@ def control_steps(
     start: int,
     arm_targets: np.ndarray,
     ctrl: np.ndarray,
-    bring_to: np.ndarray,
-    bring_rate: float,
+    brought: np.ndarray,
     hand_mocap: np.ndarray,
     site_xpos: np.ndarray,
     site_indices: np.ndarray,
@@ -120,9 +119,9 @@ def control_steps(
     """Control steps `start`, `start` + 1, ... of a movement, each `substeps` MuJoCo steps.
 
     model, data: the addresses of the MjModel and MjData. arm_targets (n, nu): the servos'
-    targets written to ctrl (nu,) before each step, or (0, nu) to leave them. bring_to (2,):
-    where the caregiver's hand (hand_mocap, its mocap_pos row) moves `bring_rate` of the way
-    before each step, or (0,) if she brings nothing. After each step row k + 1 of positions
+    targets written to ctrl (nu,) before each step, or (0, nu) to leave them. brought (n, 2):
+    where the caregiver's hand (hand_mocap, its mocap_pos row) is put before each step (her
+    path, sim/caregiver.py), or (0, 2) if she brings nothing. After each step row k + 1 of positions
     (n + 1, m) takes the flat site_xpos at `site_indices`, then the flat xpos at
     `body_indices` (m in all), as `PlayroomPhysics.write_tracked_positions` reads them.
     Returns the first step k after which a sensor at an address in `watched` is positive, or n.
@@ -143,7 +142,7 @@ def control_steps(
     switch = disable_flags.shape[0] > 0
     flags = disable_flags[0] if switch else 0
     n_sites = site_indices.shape[0]
-    may_rest = arm_targets.shape[0] == 0 and bring_to.shape[0] == 0
+    may_rest = arm_targets.shape[0] == 0 and brought.shape[0] == 0
     before, after = rest[0], rest[1]
     warned = 0
     if may_rest:
@@ -152,10 +151,9 @@ def control_steps(
         if arm_targets.shape[0] > 0:
             for j in range(ctrl.shape[0]):
                 ctrl[j] = arm_targets[k, j]
-        if bring_to.shape[0] > 0:
+        if brought.shape[0] > 0:
             for i in range(2):
-                here = hand_mocap[i]
-                hand_mocap[i] = here + bring_rate * (bring_to[i] - here)
+                hand_mocap[i] = brought[k, i]
         if may_rest:
             warned = warnings.sum()
         if switch:

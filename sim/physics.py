@@ -24,6 +24,8 @@ GRASP_CONTACTS = (
     *(f"hand_{toy}" for toy in TOYS),
     *(f"stick_{toy}" for toy in TOYS),
 )
+# The caregiver's path when she brings nothing (PlayroomPhysics.control_steps).
+_NOT_BROUGHT = np.empty((0, 2))
 
 
 class PlayroomPhysics(dm_mujoco.Physics):
@@ -255,15 +257,14 @@ class PlayroomPhysics(dm_mujoco.Physics):
         self,
         start: int,
         arm_targets: np.ndarray,
-        bring_to: np.ndarray | None,
-        bring_rate: float,
+        brought: np.ndarray | None,
         positions: np.ndarray,
         watched: np.ndarray,
     ) -> int:
         """Control steps `start`, `start` + 1, ... of a movement in compiled code, each
         CONTROL_SUBSTEPS physics steps taken as `advance` takes them: before each, the servos'
         targets arm_targets[k] (n, 3) (or, if empty, left as they are) and the caregiver's hand
-        `bring_rate` of the way to bring_to (2,) (or None: not moved); after each, the tracked
+        at brought[k] (n, 2), her path (or None: not moved); after each, the tracked
         positions in positions[k + 1] (n + 1, 5, 2). Returns the first step after which a
         sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. With no targets
         and nothing brought, the steps after one that leaves the room's state as it found it
@@ -286,8 +287,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
             start,
             arm_targets,
             d.ctrl,
-            np.empty(0) if bring_to is None else bring_to,
-            bring_rate,
+            _NOT_BROUGHT if brought is None else brought,
             self._caregiver_hand_row,
             self._site_xpos_flat,
             self._hand_handle_flat,

@@ -13,7 +13,6 @@ from models.layout import (
     N_JOINTS,
     N_STEPS,
     TOYS,
-    TRACKED_OBJECTS,
     VOICE_DIM,
     block_slice,
 )
@@ -23,13 +22,13 @@ from sim import events as ev
 from sim.caregiver import Caregiver, WordAssignment
 from sim.commands import checked_array, checked_command
 from sim.config import WorldConfig, world_preset
-from sim.dm_control_import import control
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
 from sim.grasping.base import ClosedForm
 from sim.grasping.names import DEFAULT_GRASP
-from sim.grasping.registry import backend_class
+from sim.grasping.registry import load as backend_class
 from sim.model_edits import ModelEdits
+from sim.movement import MovementOutcome, closed_form_movement, stepped_movement
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 from sim.sensory import SAMPLE_STEPS, sensory_from
 from sim.task import ARM, VOICE, MovementStepper, PlayroomTask
@@ -112,12 +111,7 @@ class Playroom:
         """
         m = checked_command(m, ARM_DIM, "arm command")
         targets = arm_trajectory(m, self.config)  # (3, N_STEPS)
-        closed = self._closed_form()
-        if closed is not None:
-            return self._run_closed_form(closed, ARM, joint_targets=targets)
-        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-        actions[:, :N_JOINTS] = targets.T
-        return self._run(ARM, actions)
+        return self._movement(ARM, targets.T, np.zeros((N_STEPS, 2)))
 
     def act_voice(self, m: np.ndarray) -> Feedback:
         """Execute 28 vocal parameters in [-1, 1] (docs/protocol.md §2) and return the feedback.
@@ -132,7 +126,6 @@ class Playroom:
         # The trajectory is finite and clipped to [-1, 1]: the tract's input checks
         # (trajectory_formants) would only repeat that.
         frames = articulators.T
-        closed = self._closed_form()
         # Unobserved, the sound is no step's input (it is not physical): only what the learner
         # and the caregiver hear, the 5 sample steps, is computed now, the other steps when the
         # feedback's `sound` is read.
@@ -141,28 +134,17 @@ class Playroom:
             if self.step_observers
             else self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
         )
-        if at_samples is not None:
+        if at_samples is not None:  # (None: the tract computes every step anyway)
             formants = np.empty((N_STEPS, 2))
             formants.fill(np.nan)  # np.full's array, without its Python wrapper
             formants[SAMPLE_STEPS] = at_samples
-            whole = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))  # noqa: E731
-            feedback = self._run_voice(closed, frames, formants)
-            feedback.sound = whole
+            feedback = self._movement(VOICE, frames, formants)
+            feedback.sound = lambda: self.task.normalised(self.vocal_tract.frame_formants(frames))
             return feedback
-        feedback = self._run_voice(closed, frames, self.vocal_tract.frame_formants(frames))
+        feedback = self._movement(VOICE, frames, self.vocal_tract.frame_formants(frames))
         if self.vocal_tract.n_fallbacks > fallbacks:  # the exact path found no formant
             feedback.events.append(ev.Event(ev.FORMANT_FALLBACK, 0))
         return feedback
-
-    def _run_voice(
-        self, closed: ClosedForm | None, frames: np.ndarray, formants: np.ndarray
-    ) -> Feedback:
-        """A vocal movement of articulator `frames` (n_steps, 7) sounding `formants`."""
-        if closed is not None:
-            return self._run_closed_form(closed, VOICE, voice_formants=formants)
-        actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-        actions[:, N_JOINTS:] = frames
-        return self._run(VOICE, actions, formants)
 
     @property
     def words(self) -> WordAssignment:
@@ -244,103 +226,57 @@ class Playroom:
             return self.backend
         return None
 
-    def _run_closed_form(
-        self,
-        closed: ClosedForm,
-        movement: str,
-        joint_targets: np.ndarray | None = None,
-        voice_formants: np.ndarray | None = None,
-    ) -> Feedback:
-        """One movement in the backend's closed form (sim/grasping/kinematic.py); the MuJoCo
-        state is set once, at the end."""
+    def _movement(self, movement: str, controls: np.ndarray, formants: np.ndarray) -> Feedback:
+        """One movement of `controls` (N_STEPS, 3) joint targets or (N_STEPS, 7) articulators;
+        formants: (N_STEPS, 2) log2 Hz of a vocal one (NaN where not computed), zeros for the
+        arm. The caregiver hears the agent, one of the paths of sim/movement.py computes the
+        movement, and `_finish` ends it, whichever path it took."""
         p = self.physics
-        positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
-        positions[0] = p.tracked_positions()
-        poses = p.object_poses()
-        sound = np.zeros((N_STEPS, 2))
-        held = None
-        still = False  # a vocal movement in which nothing moves: no movement to detect
-        if movement == ARM:
-            assert joint_targets is not None  # act_arm passes them
-            outcome = closed.arm_movement(joint_targets, poses[0], poses[1:, :2])
-            positions[1:], events, held = outcome.positions, outcome.events, outcome.hand_holds
-            poses[0] = outcome.stick_pose
+        closed = self._closed_form()
+        saved = None
+        if closed is None:
+            if isinstance(self.backend, ClosedForm):  # placed by kinematics alone (see above)
+                mujoco.mj_forward(p.model.ptr, p.data.ptr)
+            # Only the physics changes during the steps: what a divergence puts back.
+            saved = self._physics_state()
+        start = p.tracked_positions()
+        voice = movement == VOICE
+        if closed is None:
+            self.task.begin_movement(p, movement, formants if voice else None)
+        heard = self.caregiver.hear(p, formants) if voice else []
+        if closed is not None:
+            sound = self.task.normalised(formants) if voice else formants
+            outcome = closed_form_movement(
+                closed, p, self.caregiver, movement, controls, start, sound
+            )
         else:
-            assert voice_formants is not None  # act_voice passes them
-            events = self.caregiver.hear(p, voice_formants)
-            positions[1:] = positions[0]
-            if closed.voice_grasp(positions[0, 0], poses[0]):  # the study's rule
-                events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
-                positions[1:, 1] = positions[0, 0]
-                poses[0] = (*positions[0, 0], self.config.arm_rest_offset)
-            else:
-                still = self.caregiver.bringing is None
-            sound[:] = self.task.normalised(voice_formants)
-            toy = self.caregiver.bringing
-            if toy is not None:
-                path = closed.brought_path(positions[0, 2 + toy], self.caregiver.target(p))
-                positions[1:, 2 + toy] = path
-        poses[1:, :2] = positions[-1, 2:]
-        brought = self.caregiver.bringing
-        if not still:  # (movement_events finds nothing in still positions)
-            brought_name = None if brought is None else TOYS[brought]
-            events += ev.movement_events(positions, events, brought_name)
-        said = self.caregiver.speak(held, self.rng) if movement == ARM else None
-        p.set_object_poses(poses)
-        self.caregiver.stop(p)
-        return self._feedback(movement, positions, sound, events, said)
+            assert saved is not None  # saved above on every stepped path
+            actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
+            columns = slice(N_JOINTS, None) if voice else slice(N_JOINTS)
+            actions[:, columns] = controls
+            outcome = stepped_movement(
+                p, self.task, self.env, self.step_observers, actions, start, saved
+            )
+        return self._finish(movement, outcome, heard)
 
-    def _run(
-        self, movement: str, actions: np.ndarray, voice_formants: np.ndarray | None = None
-    ) -> Feedback:
+    def _finish(self, movement: str, outcome: MovementOutcome, heard: list[ev.Event]) -> Feedback:
+        """What follows every movement, whatever path computed it: which objects moved and by
+        what, the caregiver's word after an arm movement, then everything put down (a diverged
+        movement: the room put back as it was before it)."""
         p = self.physics
-        if isinstance(self.backend, ClosedForm):  # placed by kinematics alone (see above)
-            mujoco.mj_forward(p.model.ptr, p.data.ptr)
-        # Only the physics changes during the steps: what a divergence puts back.
-        saved = self._physics_state()
-        n = N_STEPS
-        positions = np.empty((n + 1, len(TRACKED_OBJECTS), 2))
-        sound = np.zeros((n, 2))
-        positions[0] = p.tracked_positions()
-        self.task.begin_movement(p, movement, voice_formants)
-        events: list[ev.Event] = []
-        if movement == VOICE:
-            assert voice_formants is not None  # act_voice passes them
-            events = self.caregiver.hear(p, voice_formants)
-        warnings = p.warning_counts()
-        task = self.task
-        try:
-            if self.step_observers:  # through the dm_control environment, observed
-                for k in range(n):
-                    obs = self.env.step(actions[k]).observation
-                    positions[k + 1] = (obs["hand"], obs["stick_handle"], *obs["toys"])
-                    sound[k] = obs["sound"]
-                    for observer in self.step_observers:
-                        observer(k + 1, obs)
-                    events += task.step_events
-            else:  # the same steps, reading only what the feedback needs
-                events += task.run_steps(p, actions, positions, sound)
-            if (p.warning_counts() > warnings).any() or not np.isfinite(positions).all():
-                raise control.PhysicsError("MuJoCo warned of an invalid state")
-        except control.PhysicsError:
-            # Divergence: put everything back where it was and report it; the room goes on.
+        if outcome.diverged_from is not None:
             self.task.end_movement(p)
-            self._restore_physics(saved)
-            positions[1:] = positions[0]
-            events = [ev.Event(ev.DIVERGED, 0)]
-            said = None
-        else:
-            brought = self.caregiver.bringing
-            events += ev.movement_events(
-                positions, events, None if brought is None else TOYS[brought]
-            )
-            said = (
-                self.caregiver.speak(self.task.grasp.hand_holds, self.rng)
-                if movement == ARM
-                else None
-            )
-            self.task.end_movement(p)
-        return self._feedback(movement, positions, sound, events, said)
+            self._restore_physics(outcome.diverged_from)
+            diverged = [ev.Event(ev.DIVERGED, 0)]
+            return self._feedback(movement, outcome.positions, outcome.sound, diverged, None)
+        events = heard + outcome.events
+        brought = self.caregiver.bringing
+        if not outcome.still:  # (movement_events finds nothing in still positions)
+            brought_name = None if brought is None else TOYS[brought]
+            events += ev.movement_events(outcome.positions, events, brought_name)
+        said = self.caregiver.speak(outcome.holds, self.rng) if movement == ARM else None
+        self.task.end_movement(p)
+        return self._feedback(movement, outcome.positions, outcome.sound, events, said)
 
     def _feedback(
         self,

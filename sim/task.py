@@ -83,7 +83,7 @@ class PlayroomTask(control.Task):
                 self.sound = self._planned_sound[self.step_index - 1]
             else:
                 self.sound = self.normalised(self.vocal_tract.formants(action[N_JOINTS:]))
-        self.caregiver.before_step(physics)
+        self.caregiver.before_step(physics, self.step_index)
 
     def after_step(self, physics: PlayroomPhysics) -> None:
         if self.movement == ARM:
@@ -137,14 +137,14 @@ class PlayroomTask(control.Task):
             targets = np.empty((0, N_JOINTS))
             sound[:] = self._planned_sound
             self.sound[:] = sound[n - 1]
-        bring_to = None if self.caregiver.bringing is None else self.caregiver.target(physics)
+        brought = self.caregiver.path  # None unless she brings a toy
         events: list[ev.Event] = []
-        k = self.grasp.run_steps(physics, targets, bring_to, 0, positions, grasping)
+        k = self.grasp.run_steps(physics, targets, brought, 0, positions, grasping)
         while k < n:  # a contact the grasp acts on, after step k
             self.step_index = k + 1
             events += self.grasp.after_step(physics, self.step_index)
             physics.write_tracked_positions(positions[k + 1])  # as the grasp left them
-            k = self.grasp.run_steps(physics, targets, bring_to, k + 1, positions, grasping)
+            k = self.grasp.run_steps(physics, targets, brought, k + 1, positions, grasping)
         self.step_index = n
         return events
 

@@ -18,7 +18,11 @@ SIMULATOR = ("mujoco", "dm_control", "numba", "sim", "learner")
         ("import experiments.analysis.results", SIMULATOR),
         ("import experiments.analysis.stats", SIMULATOR),
         ("import experiments.report.comparison", SIMULATOR),
-        ("from experiments.logs import read_log, read_batch_logs", SIMULATOR),
+        ("from experiments.analysis.logs import read_log, read_batch_logs", SIMULATOR),
+        # The log layout and the backend record: the writer's and the readers' shared files.
+        ("import experiments.log_layout, experiments.backend_record", SIMULATOR),
+        # Naming and checking the grasp backends imports none of them.
+        ("from sim.grasping.names import GRASPS", ("mujoco", "dm_control", "numba")),
         # The parser reads the settings' allowed values from sim.config and learner.config.
         (
             "from experiments.cli.main import build_parser; build_parser()",

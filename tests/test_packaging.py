@@ -45,11 +45,12 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
         names = set(archive.namelist())
         metadata = archive.read(next(n for n in names if n.endswith("METADATA"))).decode()
     assert "models/playroom.xml" in names
-    assert {f"sim/vocal/data/{n}.npz" for n in ("articulators", "formant_map", "vowels")} <= names
+    voice_data = ("articulators", "formant_map", "productions", "vowels")
+    assert {f"sim/vocal/vtl/data/{n}.npz" for n in voice_data} <= names
     assert "experiments/batches/profiles/demo.json" in names
     assert {"sim/envs/__init__.py", "sim/envs/dm_env_movement.py", "sim/envs/gym_env.py"} <= names
     # The voice's build-time fitting script is not installed (pyproject.toml excludes it).
-    assert not [n for n in names if n.startswith("sim/vocal/fitting")]
+    assert not [n for n in names if n.startswith("sim/vocal/vtl/fitting")]
     requires = [line for line in metadata.splitlines() if line.startswith("Requires-Dist:")]
     for tool in ("pytest", "pytest-xdist", "ruff", "mypy"):
         (line,) = [r for r in requires if re.split(r"[<>=!~; \[]", r.split()[1])[0] == tool]

@@ -5,9 +5,11 @@ iterations each), in a long table (iteration, metric, value):
 - tool_use: share of arm movements in which the stick moved a toy (a toy caught);
 - stick_grasp: share of arm movements in which the hand took the stick;
 - word_recognised: share of vocal movements in which the caregiver recognised a word;
-- stick_in_reach: share of iterations that began with the stick's handle within the hand's
-  reach (arm length plus grasp distance); stick_returned: share of iterations after which the
-  experimenter returned the stick (logs written before these columns existed have neither);
+- stick_in_reach: share of iterations that began with the stick's handle within the study's
+  reach (arm length plus the world's grasp distance: one yardstick for every backend,
+  experiments/backend_record.py `study_reach`); stick_returned: share of iterations after
+  which the experimenter returned the stick (logs written before these columns existed have
+  neither);
 - best_distance_names, best_distance_distractors: mean best distance so far of the trial's
   names and distractors, wherever the words log has a row.
 """
@@ -17,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from experiments.analysis.logs import SOURCE_COLUMNS
+from experiments.log_layout import SOURCE_COLUMNS
 from models.layout import TOYS
 
 CURVE_POINTS = 40

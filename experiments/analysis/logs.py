@@ -1,36 +1,15 @@
 """A trial's logs, or a batch's, read back into one pandas DataFrame.
 
-    from experiments.logs import read_log, read_batch_logs
+    from experiments.analysis.logs import read_log, read_batch_logs
     log = read_log("runs/demo/kinematic-random-seed0000")            # one row per iteration
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
-Every row carries its source: `trial` (the trial directory's name), `seed`, `backend` (the
-grasp backend) and `voice` (the vocal tract), so that rows of several trials keep apart; every
-chunk its trial's identity, so that a chunk copied from another trial is refused
-(experiments/analysis/log_chunks.py).
-Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
-`pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks'
-names, which is the iterations' order).
-
-The iterations log, one row per iteration (experiments/run/trial_files.py writes it):
-- iteration; motor_space ("arm" or "voice"); model (the chosen model, 0-based into
-  models.layout.MODELS, -1 during the bootstrap's random motor babbling);
-- stick_distance (m, the handle from the arm's base before the movement), stick_grasped,
-  stick_moved_by, toy1/2/3_moved_by ("hand", "stick", "push", "caregiver" or ""),
-  word_recognised, caregiver_said, diverged, stick_returned;
-- goal_0..goal_9: the sensory goal the agent chose, in its model's 10D block (5 samples of x
-  then 5 of y; for the sound, of F1 then F2); NaN during the bootstrap (no goal);
-- reached_0..reached_9: the outcome in that same block of the feedback, as the learner reads it
-  (clipped to [-1, 1] under the study preset), so that the attempt's competence is
-  -sqrt(sum((goal_i - reached_i)^2)); NaN during the bootstrap;
-- interest_0..interest_9: each model's interest (learning progress, learner/interest.py) when
-  the iteration's model was chosen, i.e. before this iteration's attempt; column k is model k
-  of `model`. Kept under random babbling too, where it chooses nothing.
-Goals, outcomes and interests are float32 (7 significant digits); rows written before they were
-logged hold NaN there.
-
-The words log, one row every 100 iterations: iteration and, per word, the best distance reached
-so far to it (inf before the voice was used).
+What the logs hold, column by column, and where their chunks lie: experiments/log_layout.py,
+which the writer (experiments/run/) writes by. Every row carries its source (`trial`, `seed`,
+`backend`, `voice`), so that rows of several trials keep apart; every chunk its trial's
+identity, so that a chunk copied from another trial is refused. Each kind also lies in its own
+folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so `pd.read_parquet("TRIAL/log/iterations")`
+reads exactly one kind (in the order of its chunks' names, which is the iterations' order).
 """
 
 from __future__ import annotations
@@ -43,30 +22,18 @@ import pandas as pd
 
 from experiments import storage
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
-from experiments.analysis.log_chunks import (
+from experiments.config_file import with_added_settings
+from experiments.file_names import CONFIG_FILE
+from experiments.log_layout import (
+    SOURCE_COLUMNS,
     check_chunk,
     check_kind,
     chunk_identity,
     chunk_paths,
     is_trial_dir,
+    source_of,
     trial_identity,
 )
-from experiments.config_file import with_added_settings
-from experiments.file_names import CONFIG_FILE
-
-# The columns that say which trial a row comes from, first in every row.
-SOURCE_COLUMNS = ("trial", "seed", "backend", "voice")
-
-
-def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
-    """The source columns of a trial's rows, from its directory and config."""
-    trial = config["trial"]
-    return {
-        "trial": Path(trial_dir).resolve().name,
-        "seed": int(trial["seed"]),
-        "backend": str(trial["grasp"]),
-        "voice": str(trial.get("voice", "vtl")),
-    }
 
 
 def read_log(

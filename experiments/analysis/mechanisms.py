@@ -28,10 +28,9 @@ import math
 import numpy as np
 import pandas as pd
 
+from experiments.log_layout import GOAL_COLUMNS, REACHED_COLUMNS
 from models.layout import MODELS, TOYS
 
-GOAL_COLUMNS = tuple(f"goal_{i}" for i in range(10))
-REACHED_COLUMNS = tuple(f"reached_{i}" for i in range(10))
 # The iterations log's columns `trial_mechanisms` reads beyond experiments/analysis/curves.py's.
 LOG_COLUMNS = (
     "iteration",

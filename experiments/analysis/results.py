@@ -21,10 +21,9 @@ from typing import Any
 
 import pandas as pd
 
-from experiments import storage
+from experiments import backend_record, storage
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
 from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
-from experiments.analysis.log_chunks import is_trial_dir
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
@@ -38,6 +37,7 @@ from experiments.file_names import (
     TIMING_FILE,
     VOCAL_FILE,
 )
+from experiments.log_layout import is_trial_dir
 from experiments.provenance import SHORT_FIELDS, computed_on
 
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
@@ -54,8 +54,9 @@ class BatchResults:
     mixes modes) and `seed`.
 
     - trials: eval.json's numbers (competence_all, competence_ring1..3, share_below_threshold,
-      median_names, median_distractors, ...), diverged iterations, and timing.json's
-      seconds / timed_iterations (NaN when not recorded).
+      median_names, median_distractors, ...), diverged iterations, timing.json's
+      seconds / timed_iterations (NaN when not recorded), and `reach`, how far the hand can
+      take the stick (m) as the trial's backend declared it (backend.json).
     - competence: competence.parquet rows (ring, placement, toy, x, y, distance, strategy,
       error, random_error, ...).
     - vocal: vocal.parquet rows (word, is_name, toy, best_distance); `toy` (the toy a name
@@ -275,6 +276,15 @@ def _timing(trial_dir: Path) -> tuple[float, float]:
         raise ReportError(f"{path} lacks 'seconds' and 'iterations' numbers") from None
 
 
+def _backend_reach(trial_dir: Path, config: dict) -> float:
+    """How far the trial's hand can take the stick's handle (m), as its backend declared it
+    (experiments/backend_record.py: trials from before the record, from their config)."""
+    try:
+        return float(backend_record.read_record(trial_dir, config)["reach"])
+    except (storage.CorruptFileError, ValueError) as exc:
+        raise ReportError(str(exc)) from None
+
+
 def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]:
     """Where a trial was computed (provenance.json) and evaluated (eval.json's
     `evaluated_on`): rows of BatchResults.provenance. Trials from before either was recorded
@@ -296,7 +306,7 @@ def _trial_rows(
     comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
     voc = _read_table(d / VOCAL_FILE).assign(**keys)
     log, words = _read_logs(d)
-    reach = sum(config["world"]["segment_lengths"]) + config["world"]["grasp_distance"]
+    reach = backend_record.study_reach(config["world"])  # one yardstick for every backend
     names = set(voc.loc[voc["is_name"], "word"])
     curve = curve_rows(log, words, config["trial"]["iterations"], names, reach).assign(**keys)
     seconds, timed = _timing(d)
@@ -304,6 +314,7 @@ def _trial_rows(
         **keys,
         "path": str(d),
         "grasp": config["trial"]["grasp"],
+        "reach": _backend_reach(d, config),
         "babbling": config["trial"]["babbling"],
         "iterations": config["trial"]["iterations"],
         "n_placements": summary.get("n_placements"),

@@ -16,5 +16,6 @@ from experiments.analysis.results import BatchResults
 class RoomMeasures:
     # `study_summary` of each group of a batch that holds the study's tests, by group.
     study_numbers: Callable[[BatchResults], dict[str, dict]]
-    # Share of N random arm commands that grasp the stick at its start, by backend.
-    grasp_rates: Callable[[int], dict[str, float]]
+    # Share of N random arm commands that grasp the stick at its start, in each of the named
+    # backends, by backend.
+    grasp_rates: Callable[[int, tuple[str, ...]], dict[str, float]]

@@ -2,7 +2,7 @@
 
 A trial's speed (and bits) depend on which SIMD kernels NumPy dispatches, which kernel OpenBLAS
 picks and what numba compiles for: all three follow the CPU, and all three can be told to use
-an older CPU's (../shared/notes.md). So a machine with AVX-512 measures the class without it by
+an older CPU's (docs/cpu-classes.md). So a machine with AVX-512 measures the class without it by
 switching its AVX-512 kernels off; a machine without AVX-512 cannot switch them on, and
 measures instead the next older class it can emulate (AVX without AVX2), the one `make
 test-slow` runs the suite under.

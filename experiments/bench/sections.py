@@ -102,8 +102,8 @@ def voice_figures(repeats: int = 20) -> Iterator[tuple[str, float, str]]:
     from sim.dmp import voice_trajectory
     from sim.vocal.diva.data import DivaDataError, DivaDataMissing
     from sim.vocal.diva.tract import DivaTract
-    from sim.vocal.tract import VocalTract
     from sim.vocal.voice import Voice
+    from sim.vocal.vtl.tract import VocalTract
     from sim.vocal.words import normalise
 
     rng = np.random.default_rng(0)

@@ -258,7 +258,7 @@ def cmd_say(args: argparse.Namespace) -> None:
 
     from sim.vocal.audio import write_wav
     from sim.vocal.config import DEFAULT_VOICE
-    from sim.vocal.productions import stored_distances, synthesise_word
+    from sim.vocal.vtl.productions import stored_distances, synthesise_word
 
     if args.word not in DEFAULT_VOICE.words:
         raise UsageError(f"unknown word {args.word!r}: one of {', '.join(DEFAULT_VOICE.words)}")

@@ -35,6 +35,7 @@ from experiments.run.trial_checks import load_trial
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom
+from sim.grasping.names import GRASPS
 
 SCENES = ("test", "stick_at_start", "remembered", "alone")
 # Where the other toys wait in the "alone" scene: beyond ring 3 and every reach, on the table.
@@ -88,7 +89,7 @@ def replay_table(agent: Agent, room: Playroom, settings: EvaluationSettings) -> 
 def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
     """`replay_table` of the first `n_trials` finished trials of each backend of a batch."""
     tables = []
-    for grasp in ("kinematic", "physical"):
+    for grasp in GRASPS:
         dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / "eval.json").exists())
         for trial_dir in dirs[:n_trials]:
             config, agent, room, _ = load_trial(trial_dir)

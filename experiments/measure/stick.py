@@ -1,17 +1,18 @@
-"""The stick as a tool across the two backends: what pushes it, how often it can be grasped.
+"""The stick as a tool across the backends: what pushes it, how often it can be grasped.
 
 - `push_sources`: plays a trial's first iterations (its agent and room, as `playroom run` would)
   while watching every control step, and attributes each push of the stick (it moved while the
   hand did not hold it) to what touched it: the hand, a toy the hand holds, a free toy.
 - `grasp_rates`: the share of random arm commands that grasp the stick from its start pose, in
-  both backends, for the very same commands: how much harder contact grasping is than the
-  study's distance rule.
+  each backend asked (every registered one by default), for the very same commands: how much
+  harder contact grasping is than the study's distance rule.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections import Counter
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -77,15 +78,19 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
 
 
 def grasp_rates(
-    n_commands: int = 1000, seed: int = 0, progress: bool | None = None
+    n_commands: int = 1000,
+    grasps: Sequence[str] = GRASPS,
+    seed: int = 0,
+    progress: bool | None = None,
 ) -> dict[str, float]:
-    """Share of random arm commands that grasp the stick, per backend, each command from the
-    same scene: the stick at its start pose, the toys where the room's seed placed them.
+    """Share of random arm commands that grasp the stick, per backend of `grasps`, each
+    command from the same scene: the stick at its start pose, the toys where the room's seed
+    placed them. A backend's share does not depend on which others are measured beside it.
     progress: a bar on stderr (None: only on a terminal)."""
     from tqdm import tqdm
 
     bar = tqdm(
-        total=n_commands * len(GRASPS),
+        total=n_commands * len(grasps),
         disable=None if progress is None else not progress,
         desc="grasp rates",
         unit="command",
@@ -94,7 +99,7 @@ def grasp_rates(
     commands = rng.uniform(-1.0, 1.0, (n_commands, ARM_DIM))
     start = (*DEFAULT_WORLD.stick_start_handle, DEFAULT_WORLD.stick_start_angle)
     rates = {}
-    for grasp in GRASPS:
+    for grasp in grasps:
         config = dataclasses.replace(DEFAULT_WORLD, stick_return="never")
         room = Playroom(grasp, seed=seed, config=config)
         toys = room.context()[2:8].reshape(3, 2)

@@ -104,8 +104,9 @@ def seeds_text(seeds: list[int]) -> str:
 
 
 def settings_table(results: BatchResults) -> Table:
-    """One row per group: trials, seeds, iterations, babbling, preset, stick return, vocal
-    tract, placements, package version."""
+    """One row per group: trials, seeds, iterations, babbling, preset, stick return, the
+    hand's reach as the group's backend declared it (backend.json), vocal tract, placements,
+    package version."""
     rows = []
     for group in results.groups:
         trials = results.trials[results.trials["group"] == group]
@@ -119,6 +120,7 @@ def settings_table(results: BatchResults) -> Table:
                 str(config["trial"]["babbling"]),
                 str(config["trial"].get("preset", "?")),
                 str(config["world"].get("stick_return", "?")),
+                f"{trials['reach'].iloc[0]:g} m" if "reach" in trials else "?",
                 TRACT_NAMES.get(config["world"]["voice"], config["world"]["voice"]),
                 str(trials["n_placements"].iloc[0]),
                 str(config.get("package_version", "?")),
@@ -132,6 +134,7 @@ def settings_table(results: BatchResults) -> Table:
         "babbling",
         "preset",
         "stick return",
+        "hand's reach",
         "vocal tract",
         "placements per ring",
         "package version",

@@ -5,7 +5,9 @@ reach docs/protocol.md D14 proposes; docs/stick-grasp-rate.png was drawn by
 
     python -m experiments.report.stick_reach BATCH_DIR --out docs/stick-grasp-rate.png
 
-which also prints the table (markdown) and the distance `falling_rate_distance` finds.
+which also prints the table (markdown) and, per backend, the distance `falling_rate_distance`
+finds where it finds one. Each backend's reach is drawn as its trials recorded it
+(experiments/backend_record.py): any set of backends, none known here by name.
 """
 
 from __future__ import annotations
@@ -16,20 +18,19 @@ import os
 import platform
 import sys
 import textwrap
-import xml.etree.ElementTree as ET
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from experiments import provenance, storage
+from experiments import backend_record, provenance, storage
 from experiments.analysis.curves import falling_rate_distance, grasp_rate_by_distance
 from experiments.analysis.logs import read_log
 from experiments.file_names import CONFIG_FILE
 from experiments.report.figures import group_colour, png_bytes
-from models import playroom_xml
 
 # The proposal's rule (falling_rate_distance): the first 1 cm bin beyond the start pose's whose
 # grasp rate is below half of the start's, among bins of at least 100 arm movements.
@@ -38,38 +39,58 @@ FRACTION = 0.5
 MIN_ITERATIONS = 100
 
 
-def batch_rates(batch_dir: Path, bin_width: float = BIN_WIDTH) -> tuple[dict, dict, dict]:
-    """(backend -> rate table of its trials' logs pooled, backend -> its trials' config,
-    backend -> how many trials)."""
+@dataclass(frozen=True)
+class BatchRates:
+    """Per backend of a batch: the rate table of its trials' logs pooled, its trials' config
+    and backend record (backend.json), and how many trials it has."""
+
+    rates: dict[str, pd.DataFrame]
+    configs: dict[str, dict]
+    records: dict[str, dict]
+    counts: dict[str, int]
+
+
+def batch_rates(batch_dir: Path, bin_width: float = BIN_WIDTH) -> BatchRates:
+    """The batch's trials by backend (`BatchRates`)."""
     logs: dict[str, list[pd.DataFrame]] = {}
     configs: dict[str, dict] = {}
+    records: dict[str, dict] = {}
     for config_path in sorted(batch_dir.glob(f"*/{CONFIG_FILE}")):
         config = storage.read_json(config_path)
         grasp = config["trial"]["grasp"]
         logs.setdefault(grasp, []).append(read_log(config_path.parent))
         configs[grasp] = config
+        records[grasp] = backend_record.read_record(config_path.parent, config)
     rates = {g: grasp_rate_by_distance(pd.concat(ls), bin_width) for g, ls in logs.items()}
-    return rates, configs, {g: len(ls) for g, ls in logs.items()}
-
-
-def contact_limit(config: dict) -> float:
-    """The physical return's distance for a handle pointing outward: the arm's length plus the
-    radii of the hand sphere and of the handle geom (models/playroom.xml), as
-    `PhysicalGrasp.stick_out_of_reach` computes it from the compiled model."""
-    geoms = {g.get("name"): g for g in ET.parse(playroom_xml()).iter("geom")}
-    radii = sum(float(str(geoms[n].get("size")).split()[0]) for n in ("hand", "stick_handle"))
-    return float(sum(config["world"]["segment_lengths"])) + radii
+    return BatchRates(rates, configs, records, {g: len(ls) for g, ls in logs.items()})
 
 
 def start_distance(config: dict) -> float:
     return float(np.hypot(*config["world"]["stick_start_handle"]))
 
 
-def figure(rates: dict[str, pd.DataFrame], configs: dict[str, dict], caption: str) -> Figure:
+def distance_lines(batch: BatchRates) -> list[tuple[float, str, str, str]]:
+    """(distance, colour, line style, label) of the figure's vertical lines: the stick's start,
+    then per backend, in its colour, its reach as its trials recorded it (dashed) and the return
+    reach its grasp rate proposes (solid), where the rule finds one."""
+    config = next(iter(batch.configs.values()))
+    lines = [(start_distance(config), "k", ":", "stick's start")]
+    groups = sorted(batch.rates)
+    for grasp in groups:
+        colour, reach = group_colour(groups, grasp), float(batch.records[grasp]["reach"])
+        lines.append((reach, colour, "--", f"{grasp}: the hand's reach ({reach:.3g} m)"))
+        proposed = proposal(batch.rates[grasp], batch.configs[grasp])
+        if math.isfinite(proposed):
+            lines.append((proposed, colour, "-", f"{grasp}: proposed return reach"))
+    return lines
+
+
+def figure(batch: BatchRates, caption: str) -> Figure:
     """Grasp rate per bin (top) and arm movements per bin (bottom), one line per backend, with
-    the start distance, the current return distances and the proposed one."""
+    the start distance, each backend's reach and the return reach proposed for it."""
     fig = Figure(figsize=(9.0, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
+    rates = batch.rates
     groups = sorted(rates)
     for grasp in groups:
         table, colour = rates[grasp], group_colour(groups, grasp)
@@ -84,23 +105,7 @@ def figure(rates: dict[str, pd.DataFrame], configs: dict[str, dict], caption: st
             alpha=0.5,
             label=grasp,
         )
-    config = next(iter(configs.values()))
-    lines = [(start_distance(config), "k", ":", "stick's start")]
-    world = config["world"]
-    lines.append(
-        (
-            sum(world["segment_lengths"]) + world["grasp_distance"],
-            "tab:gray",
-            "--",
-            "kinematic return (arm + grasp distance)",
-        )
-    )
-    if "physical" in rates:
-        lines.append((contact_limit(config), "tab:orange", "--", "physical return now (contact)"))
-        proposed = proposal(rates["physical"], config)
-        if math.isfinite(proposed):
-            lines.append((proposed, "tab:green", "-", "proposed return reach"))
-    for x, colour, style, label in lines:
+    for x, colour, style, label in distance_lines(batch):
         for ax in (top, bottom):
             ax.axvline(x, color=colour, ls=style, lw=1, label=label if ax is top else None)
     top.set_ylabel("arm movements that grasp the stick (%)")
@@ -116,8 +121,9 @@ def figure(rates: dict[str, pd.DataFrame], configs: dict[str, dict], caption: st
     return fig
 
 
-def proposal(physical: pd.DataFrame, config: dict) -> float:
-    return falling_rate_distance(physical, start_distance(config), FRACTION, MIN_ITERATIONS)
+def proposal(rates: pd.DataFrame, config: dict) -> float:
+    """The return reach D14's rule proposes from a backend's rate table (NaN: none)."""
+    return falling_rate_distance(rates, start_distance(config), FRACTION, MIN_ITERATIONS)
 
 
 def markdown(rates: dict[str, pd.DataFrame]) -> str:
@@ -149,14 +155,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("batch_dir", type=Path)
     parser.add_argument("--out", type=Path, required=True, help="the figure (PNG)")
     args = parser.parse_args(argv)
-    rates, configs, counts = batch_rates(args.batch_dir)
+    batch = batch_rates(args.batch_dir)
+    rates = batch.rates
     if not rates:
         print(f"{args.batch_dir} holds no trial", file=sys.stderr)
         return 2
     machine = provenance.short_record(provenance.machine_record())
     assert machine is not None  # a record was given
     command = f"python -m experiments.report.stick_reach {args.batch_dir} --out {args.out}"
-    trials = ", ".join(f"{g}: {counts[g]} trials" for g in sorted(rates))
+    trials = ", ".join(f"{g}: {batch.counts[g]} trials" for g in sorted(rates))
     caption = (
         f"{command}: logs of {args.batch_dir} ({trials}); drawn on {machine['cpu']} "
         f"({os.cpu_count()} cores, {platform.machine()}, NumPy SIMD {machine['simd']}), "
@@ -164,13 +171,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"Proposed: the first bin past the start's whose rate is below {FRACTION:g} x the "
         f"start bin's, bins of >= {MIN_ITERATIONS} movements."
     )
-    storage.write_files(
-        args.out.parent, {args.out.name: png_bytes(figure(rates, configs, caption))}
-    )
+    storage.write_files(args.out.parent, {args.out.name: png_bytes(figure(batch, caption))})
     print(markdown(rates))
-    if "physical" in rates:
-        proposed = proposal(rates["physical"], configs["physical"])
-        print(f"proposed physical return reach: {proposed:.2f} m")
+    for grasp in sorted(rates):
+        proposed = proposal(rates[grasp], batch.configs[grasp])
+        if math.isfinite(proposed):
+            print(f"proposed {grasp} return reach: {proposed:.2f} m")
     return 0
 
 

@@ -23,9 +23,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import provenance, storage
-from experiments.analysis.log_chunks import CHUNK_IDENTITY_KEY, EXTENSIBLE, chunk_path
-from experiments.analysis.logs import SOURCE_COLUMNS, source_of
+from experiments import backend_record, provenance, storage
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
@@ -37,13 +35,20 @@ from experiments.file_names import (
     STALE_PREFIX,
     TRIAL_ENTRIES,
 )
+from experiments.log_layout import (
+    CHUNK_IDENTITY_KEY,
+    EXTENSIBLE,
+    LEARNER_COLUMNS,
+    LEARNER_DTYPE,
+    SOURCE_COLUMNS,
+    chunk_path,
+    source_of,
+)
 from experiments.run import estimate, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, is_litter, prepare_resume, remove_litter
 from experiments.run.trial_files import (
-    LEARNER_COLUMNS,
-    LEARNER_DTYPE,
     LOG_README,
     WORDS_LOG_PERIOD,
     TrialError,
@@ -97,6 +102,12 @@ class Trial:
                 self.notices += provenance.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()
                 )
+                # What its backend declares, for analysis to read (backend.json).
+                backend = self.room.backend
+                record = backend_record.make_record(
+                    backend.name, backend.reach(), backend.capabilities()
+                )
+                backend_record.write_once(self.dir, record)
         except BaseException:
             self.close()
             raise
@@ -317,7 +328,7 @@ class Trial:
             table.insert(position, column, self.source[column])
         path = chunk_path(self.dir, kind, start)
         path.parent.mkdir(exist_ok=True)
-        # Written into the Parquet schema's metadata (experiments/analysis/log_chunks.py).
+        # Written into the Parquet schema's metadata (experiments/log_layout.py).
         table.attrs[CHUNK_IDENTITY_KEY] = self.identity
         storage.write_table(path, table, plain=plain)
 

@@ -1,6 +1,6 @@
 """Reading a trial directory back only when it is whole, and saying truly what is not.
 
-- A checkpoint is used only if it is the trial's own (its identity, log_chunks.trial_identity)
+- A checkpoint is used only if it is the trial's own (its identity, log_layout.trial_identity)
   and readable; the newest is preferred, the previous one is the fallback of a resume only.
 - The log chunks a checkpoint covers must be present, the trial's own (the identity they
   carry, if they carry one) and hold what their names say: a lost chunk cannot be regenerated
@@ -18,14 +18,6 @@ import os
 from pathlib import Path
 
 from experiments import storage
-from experiments.analysis.log_chunks import (
-    DuplicateChunkError,
-    ForeignChunkError,
-    check_chunk,
-    chunk_path,
-    chunk_paths,
-    trial_identity,
-)
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     CHECKPOINT_FILE,
@@ -34,6 +26,14 @@ from experiments.file_names import (
     LOG_DIR,
     LOG_KINDS,
     PREVIOUS_CHECKPOINT_FILE,
+)
+from experiments.log_layout import (
+    DuplicateChunkError,
+    ForeignChunkError,
+    check_chunk,
+    chunk_path,
+    chunk_paths,
+    trial_identity,
 )
 from experiments.run.old_logs import move_old_chunks
 from experiments.run.trial_files import (
@@ -95,7 +95,7 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
 
 
 def _chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
-    """The chunks of one kind of log, of both layouts (experiments/analysis/log_chunks.py);
+    """The chunks of one kind of log, of both layouts (experiments/log_layout.py);
     TrialError for a chunk found in both."""
     try:
         return chunk_paths(trial_dir, kind)

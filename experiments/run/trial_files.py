@@ -11,12 +11,14 @@ A trial directory holds:
 - `log/words/chunk-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to
   each of the 6 words, in the chunk of the period that reaches them;
   every row of both carries its source (trial, seed, backend, voice), and every chunk its
-  trial's identity, as checkpoints do (experiments/analysis/log_chunks.py); the columns are
-  listed in experiments/analysis/logs.py, which reads them back (trials of the old layout too:
-  log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
+  trial's identity, as checkpoints do; where the chunks lie and what every column holds is
+  experiments/log_layout.py, which this writer and every reader follow (trials of the old
+  layout too: log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
 - `log/README.txt`: which folder of log/ to read (a reader of all of log/ stops on it);
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
   iterations, one entry per run or resume (experiments/provenance.py);
+- `backend.json`: what the grasp backend declares of itself (its reach, its capabilities),
+  written when the trial first computes (experiments/backend_record.py);
 - `.lock`: the lock of its one writer (experiments/run/lock.py).
 Everything else in it (evaluation, timing, videos) is derived from the trial at some iteration.
 The writer is experiments/run/trial.py; experiments/run/trial_checks.py reads a trial back only
@@ -32,11 +34,11 @@ from pathlib import Path
 import numpy as np
 
 from experiments import storage
-from experiments.analysis.log_chunks import identity_text, trial_identity
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
+from experiments.log_layout import identity_text, trial_identity
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
-from models.layout import BLOCK_DIM, MODELS, TOYS, context_indices
+from models.layout import BLOCK_DIM, TOYS, context_indices
 from sim import Playroom
 from sim import events as ev
 from sim.config import WorldConfig, config_from_dict
@@ -54,19 +56,10 @@ This folder holds a trial's logs, one folder per kind, one Parquet chunk per che
                                               pd.read_parquet("TRIAL/log/words")
 The kinds have different rows: read one of the folders, not this one (this file stops a reader
 of the whole folder before it mixes them). Every row names its trial, seed, backend and voice.
-With the project installed: `from experiments.logs import read_log, read_batch_logs`; the
-columns are described in experiments/analysis/logs.py.
+With the project installed: `from experiments.analysis.logs import read_log, read_batch_logs`;
+the columns are described in experiments/log_layout.py.
 """
 
-# The learner's columns of the iterations log: the goal and the outcome in the chosen model's
-# sensory block, and every model's interest (experiments/analysis/logs.py says what each holds).
-GOAL_COLUMNS = tuple(f"goal_{i}" for i in range(BLOCK_DIM))
-REACHED_COLUMNS = tuple(f"reached_{i}" for i in range(BLOCK_DIM))
-INTEREST_COLUMNS = tuple(f"interest_{k}" for k in range(len(MODELS)))
-LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
-# Stored as float32: 7 significant digits are plenty to plot and average them, at half the size
-# of float64 (random goals hardly compress). The other columns keep their types.
-LEARNER_DTYPE = np.float32
 _NO_BLOCK = np.full(BLOCK_DIM, np.nan)
 
 
@@ -132,8 +125,8 @@ def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
 def learner_values(
     proposal: Proposal, reached: np.ndarray | None, interests: np.ndarray
 ) -> np.ndarray:
-    """The learner's columns of an iteration's row (LEARNER_COLUMNS), (30,): the goal (NaN
-    without one: the bootstrap's random motor babbling), the outcome in the goal's block
+    """The learner's columns of an iteration's row (log_layout.LEARNER_COLUMNS), (30,): the goal
+    (NaN without one: the bootstrap's random motor babbling), the outcome in the goal's block
     (`Agent.outcome`, NaN without a model) and each model's interest when the model was
     chosen (`Agent.interests`, read before the iteration's attempt)."""
     return np.concatenate(

@@ -1,12 +1,15 @@
 """Grasp backends: how the arm moves and what it takes, one module per backend.
 
-- `names`: the backends' names and the default one (no MuJoCo: the command line reads them).
+- `registry`: `REGISTRY`, name -> "module:Class", the one table of the backends (lazy: it
+  imports none), and `load(name)`, which imports one.
+- `names`: the backends' names (the registry's keys) and the default one; no MuJoCo, so the
+  command line reads them.
 - `base`: `GraspBackend`, what every backend offers the room, the task, the caregiver and the
-  experimenter; `ClosedForm`, what a backend whose movements are closed-form geometry adds.
+  experimenter, and what it declares for the trial's record (`reach`, `capabilities`);
+  `ClosedForm`, what a backend whose movements are closed-form geometry adds.
 - `kinematic`: the study's distance rules, stepped and in closed form side by side.
 - `physical`: grasping through MuJoCo contacts and welds.
-- `registry`: name -> backend class (`BACKENDS`, `backend_class`).
 
-Adding a backend: a module with a `GraspBackend` subclass, its name in `names.GRASPS`, its
-class in `registry.BACKENDS`.
+Adding a backend: a module with a `GraspBackend` subclass and one line in
+`registry.REGISTRY`; tests/world/test_backend_contract.py runs every registered backend.
 """

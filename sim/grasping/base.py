@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -21,6 +22,14 @@ from sim import events as ev
 from sim.config import WorldConfig
 from sim.model_edits import ModelEdits
 from sim.physics import PlayroomPhysics
+
+
+class Holds(NamedTuple):
+    """What the hand holds ("stick", "toy1", ... or None) and which toy the stick's tip holds
+    (0-based, or None)."""
+
+    hand: str | None
+    stick: int | None
 
 
 class GraspBackend(abc.ABC):
@@ -59,19 +68,25 @@ class GraspBackend(abc.ABC):
     def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         """Look at the world after the step and attach what the rules say."""
 
+    @property
+    def holds(self) -> Holds:
+        """What the hand and the stick's tip hold now."""
+        return Holds(self.hand_holds, self.stick_holds)
+
     def run_steps(
         self,
         physics: PlayroomPhysics,
         arm_targets: np.ndarray,
-        bring_to: np.ndarray | None,
+        brought: np.ndarray | None,
         start: int,
         positions: np.ndarray,
         grasping: bool,
     ) -> int:
         """Control steps from `start` in compiled code, as `before_step` and the caregiver's
-        carrying would take them; while `grasping` (an arm movement), until a contact that
-        would take something appears: returns that step, whose `after_step` the caller then
-        takes, or n. Only for a backend with `has_compiled_steps`."""
+        carrying would take them (`brought`: her path, (n, 2), or None); while `grasping` (an
+        arm movement), until a contact that would take something appears: returns that step,
+        whose `after_step` the caller then takes, or n. Only for a backend with
+        `has_compiled_steps`."""
         raise NotImplementedError(f"the {self.name} backend has no compiled steps")
 
     def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
@@ -88,13 +103,14 @@ class GraspBackend(abc.ABC):
 
     # The caregiver bringing a toy (sim/caregiver.py) --------------------------------------
     @abc.abstractmethod
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:
-        """She takes toy `toy` (0-based) to bring it over the coming control steps."""
+    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """She takes toy `toy` (0-based) to bring it over the coming control steps. Returns
+        (2,) where what she moves starts: her path (`Caregiver`) begins there."""
 
     @abc.abstractmethod
-    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, target: np.ndarray) -> None:
-        """One control step: toy `toy` moves `caregiver_bring_rate` of the remaining way to
-        `target` (2,)."""
+    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, place: np.ndarray) -> None:
+        """One control step: what she moves with toy `toy` goes to `place` (2,), the step's
+        point of her path."""
 
     @abc.abstractmethod
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
@@ -104,6 +120,19 @@ class GraspBackend(abc.ABC):
     @abc.abstractmethod
     def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
         """Whether this backend's grasp rule can no longer reach the stick's handle."""
+
+    # What a trial records of its backend (backend.json: experiments/backend_record.py) ----
+    @abc.abstractmethod
+    def reach(self) -> float:
+        """How far from the arm's base (m) the hand can take the stick's handle. Declared here,
+        recorded by the trial and read by analysis and reports, which rebuild no backend rule."""
+
+    def capabilities(self) -> dict[str, bool]:
+        """What a reader of this backend's trials may need to know: `solid` (see above),
+        `pushes` (an unheld object moves when something touches it: solid, unless the world
+        switches pushing off), `closed_form` (movements computed whole: `ClosedForm`)."""
+        pushes = self.solid and self.config.push_objects
+        return {"solid": self.solid, "pushes": pushes, "closed_form": isinstance(self, ClosedForm)}
 
     def _free_toy_mask(self) -> np.ndarray:
         """(3,) bool: toys that neither the hand nor the stick holds."""
@@ -117,17 +146,17 @@ class GraspBackend(abc.ABC):
 
 @dataclass
 class ArmMovement:
-    """What an arm movement does to the room.
+    """What an arm movement does to the room, in closed form.
 
     positions: (N_STEPS, 5, 2) hand, stick handle, toy1-3 after each control step (m).
     stick_pose: (3,) handle x, y (m) and yaw (rad) after the movement.
-    events: grasps and catches, in step order. hand_holds: what the hand holds at the end.
+    events: grasps and catches, in step order. holds: what is held at the end.
     """
 
     positions: np.ndarray
     stick_pose: np.ndarray
     events: list[ev.Event]
-    hand_holds: str | None
+    holds: Holds
 
 
 class ClosedForm(GraspBackend):
@@ -145,10 +174,6 @@ class ClosedForm(GraspBackend):
     @abc.abstractmethod
     def voice_grasp(self, hand: np.ndarray, stick_pose: np.ndarray) -> bool:
         """Whether the resting hand at `hand` (2,) takes the stick during a vocal movement."""
-
-    @abc.abstractmethod
-    def brought_path(self, start: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """(N_STEPS, 2) positions of a toy the caregiver brings from `start` toward `target`."""
 
 
 def arm_to_rest(physics: PlayroomPhysics) -> None:

@@ -19,7 +19,7 @@ import numpy as np
 
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
-from sim.grasping.base import ArmMovement, ClosedForm, arm_to_rest
+from sim.grasping.base import ArmMovement, ClosedForm, Holds, arm_to_rest
 from sim.kinematics import hand_positions
 from sim.physics import PlayroomPhysics
 
@@ -180,18 +180,21 @@ class KinematicGrasp(ClosedForm):
         if on_stick != kernel.NONE:
             events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
         final_stick = np.array(stick_pose, dtype=float)
+        # A toy the lying stick caught stays on it; only a free stick catches in the hand.
+        on_tip = None if on_stick == kernel.NONE else on_stick
         if k == N_STEPS:
-            return ArmMovement(positions, final_stick, events, None)
+            return ArmMovement(positions, final_stick, events, Holds(None, on_tip))
         if first > 0:
             toy = TOYS[first - 1]
             events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=toy, by="hand"))
-            return ArmMovement(positions, final_stick, _in_step_order(events), toy)
+            return ArmMovement(positions, final_stick, _in_step_order(events), Holds(toy, on_tip))
         events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
         final_stick = np.array([*positions[-1, 0], absolute[-1, -1]])
         if caught_toy != kernel.NONE:
             obj = TOYS[caught_toy]
             events.append(ev.Event(ev.TOY_CAUGHT, caught_step + 1, obj=obj, by="stick"))
-        return ArmMovement(positions, final_stick, _in_step_order(events), "stick")
+            on_tip = caught_toy
+        return ArmMovement(positions, final_stick, _in_step_order(events), Holds("stick", on_tip))
 
     @functools.cached_property
     def _lengths(self) -> np.ndarray:
@@ -223,38 +226,29 @@ class KinematicGrasp(ClosedForm):
             return False
         return bool(np.hypot(*(stick_pose[:2] - hand)) < self.config.grasp_distance)
 
-    # The caregiver bringing a toy: placed directly, stepped and in closed form ------------
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:
-        """Nothing to do: the toy is placed directly at every step, as in the study."""
+    # The caregiver bringing a toy: placed directly along her path, as in the study -------
+    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """Nothing to take: the toy itself is placed at every step; its path starts where it
+        lies."""
+        return physics.object_poses()[1 + toy, :2]
 
-    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, target: np.ndarray) -> None:
-        rate = self.config.caregiver_bring_rate
+    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, place: np.ndarray) -> None:
         poses = physics.object_poses()
-        poses[1 + toy, :2] += rate * (target - poses[1 + toy, :2])
+        poses[1 + toy, :2] = place
         physics.set_object_poses(poses)
 
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
         """Nothing to undo: the toy lies where it was last placed."""
-
-    def brought_path(self, start: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """`caregiver_carries`' arithmetic, repeated over the N_STEPS control steps."""
-        rate = self.config.caregiver_bring_rate
-        # The same operations on each coordinate, in Python floats (IEEE doubles, as NumPy's):
-        # a 50-step loop of 2-vector NumPy operations cost 180 us.
-        path = np.empty((N_STEPS, 2))
-        x, y = (float(v) for v in start)
-        tx, ty = (float(v) for v in target)
-        for k in range(N_STEPS):
-            x += rate * (tx - x)
-            y += rate * (ty - y)
-            path[k] = x, y
-        return path
 
     # The experimenter ---------------------------------------------------------------------
     def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
         """The handle lies beyond the arm's length plus the grasp distance."""
         cfg = self.config
         return float(np.hypot(*physics.stick_handle())) > cfg.arm_length + cfg.grasp_distance
+
+    def reach(self) -> float:
+        """The arm's length plus the grasp distance: `stick_out_of_reach`'s limit."""
+        return self.config.arm_length + self.config.grasp_distance
 
 
 def _in_step_order(events: list[ev.Event]) -> list[ev.Event]:

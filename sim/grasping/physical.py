@@ -48,16 +48,14 @@ class PhysicalGrasp(GraspBackend):
         self,
         physics: PlayroomPhysics,
         arm_targets: np.ndarray,
-        bring_to: np.ndarray | None,
+        brought: np.ndarray | None,
         start: int,
         positions: np.ndarray,
         grasping: bool,
     ) -> int:
         """`GraspBackend.run_steps`, through PlayroomPhysics.control_steps."""
         watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
-        return physics.control_steps(
-            start, arm_targets, bring_to, self.config.caregiver_bring_rate, positions, watched
-        )
+        return physics.control_steps(start, arm_targets, brought, positions, watched)
 
     def watched_contacts(self) -> np.ndarray:
         """Indices into GRASP_CONTACTS (sim/physics.py) of the contacts that would take
@@ -143,7 +141,8 @@ class PhysicalGrasp(GraspBackend):
         arm_to_rest(physics)
 
     # The caregiver bringing a toy ---------------------------------------------------------
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> None:
+    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """Her hand goes to the toy and takes it; her path starts there."""
         m, d = physics.model.ptr, physics.data.ptr
         hand = physics.caregiver_hand_mocap
         d.mocap_pos[hand, :2] = physics.toy_positions()[toy]
@@ -154,13 +153,11 @@ class PhysicalGrasp(GraspBackend):
         # table would not (dragged along the table it would sweep the stick out of reach).
         self.edits.make_intangible(CAREGIVER, physics.toy_geoms[toy])
         self.edits.lift(CAREGIVER, OBJECTS.index(TOYS[toy]))
+        return d.mocap_pos[hand, :2].copy()
 
-    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, target: np.ndarray) -> None:
+    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, place: np.ndarray) -> None:
         """Her hand moves; the weld brings the toy along through the dynamics."""
-        rate = self.config.caregiver_bring_rate
-        d = physics.data.ptr
-        hand = physics.caregiver_hand_mocap
-        d.mocap_pos[hand, :2] += rate * (target - d.mocap_pos[hand, :2])
+        physics.data.ptr.mocap_pos[physics.caregiver_hand_mocap, :2] = place
 
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
         self.edits.clear(CAREGIVER)
@@ -190,3 +187,11 @@ class PhysicalGrasp(GraspBackend):
         half = m.geom_size[handle, 1]
         nearest = segment_distance(np.zeros(2), centre - half * axis, centre + half * axis)
         return nearest > limit
+
+    def reach(self) -> float:
+        """The arm's length plus the radii of the hand sphere and of the handle: beyond it no
+        point of the handle can touch the hand (`stick_out_of_reach`'s contact limit)."""
+        physics = self.edits.physics
+        sizes = physics.model.ptr.geom_size
+        contact = sizes[physics.hand_geom, 0] + sizes[physics.handle_geom, 0]
+        return float(self.config.arm_length + contact)

@@ -1,28 +1,38 @@
-"""The grasp backends by name: what `Playroom(grasp=...)` builds (it loads the backend's
-`physics_class`, then makes the backend with the physics' `ModelEdits`).
+"""The grasp backends by name, lazily: name -> "module:Class", as Gymnasium registers its
+environments.
 
-`names.GRASPS` lists the same names without importing MuJoCo (the command line and the trial
-settings read it); this module refuses to import if the two disagree.
+`REGISTRY` is the one table of the backends. Naming or checking a backend (the command line,
+the trial settings, a batch's spec: `names.GRASPS` is this table's keys) imports none of them,
+so neither MuJoCo nor numba; `load` imports a backend's module only when a room is built with
+it (`Playroom(grasp=...)` loads the class, then the class's `physics_class`). A backend whose
+module fails to import breaks only itself. The vocal tracts' registry has the same shape
+(models/tracts.py, sim/vocal/registry.py).
+
+Adding a backend: its module (a `sim.grasping.base.GraspBackend` subclass whose `name` is its
+key here) and one line below; tests/world/test_backend_contract.py then runs it.
 """
 
 from __future__ import annotations
 
-from sim.grasping.base import GraspBackend
-from sim.grasping.kinematic import KinematicGrasp
-from sim.grasping.names import GRASPS
-from sim.grasping.physical import PhysicalGrasp
+import importlib
+from typing import TYPE_CHECKING
 
-BACKENDS: dict[str, type[GraspBackend]] = {cls.name: cls for cls in (KinematicGrasp, PhysicalGrasp)}
+if TYPE_CHECKING:
+    from sim.grasping.base import GraspBackend
 
-if tuple(BACKENDS) != GRASPS:
-    raise ImportError(
-        f"sim.grasping.registry holds the backends {tuple(BACKENDS)} but "
-        f"sim.grasping.names.GRASPS lists {GRASPS}: list each backend in both, in one order"
-    )
+REGISTRY: dict[str, str] = {
+    # The study's distance rules, stepped and in closed form (docs/protocol.md §5, §6).
+    "kinematic": "sim.grasping.kinematic:KinematicGrasp",
+    # Grasping through MuJoCo contacts and welds (docs/protocol.md §11 D16).
+    "physical": "sim.grasping.physical:PhysicalGrasp",
+}
 
 
-def backend_class(name: str) -> type[GraspBackend]:
-    """The backend class called `name`; ValueError naming the choices."""
-    if name not in BACKENDS:
-        raise ValueError(f"unknown grasp backend {name!r}: choose one of {list(BACKENDS)}")
-    return BACKENDS[name]
+def load(name: str) -> type[GraspBackend]:
+    """The backend class registered as `name`, its module imported now; ValueError naming
+    the choices."""
+    target = REGISTRY.get(name)
+    if target is None:
+        raise ValueError(f"unknown grasp backend {name!r}: choose one of {list(REGISTRY)}")
+    module, _, attribute = target.partition(":")
+    return getattr(importlib.import_module(module), attribute)

@@ -1,26 +1,35 @@
 """The vocal tracts by name: what the room builds its voice from.
 
-Adding a tract: a module with a `sim.vocal.voice.Voice` subclass, its class here and its name in
-models/tracts.py (which the settings check without importing any synthesizer).
+`REGISTRY` (models/tracts.py, the one table) maps each name to "module:Class"; `load` imports
+the class only when a tract of that name is asked for, so naming or checking a tract imports no
+synthesizer, and a tract whose module fails to import breaks only itself. The grasp backends'
+registry has the same shape (sim/grasping/registry.py).
 """
 
 from __future__ import annotations
 
-from models.tracts import TRACTS as TRACT_NAMES
+import importlib
+
+from models.tracts import REGISTRY, TRACTS
 from sim.config import WorldConfig
 from sim.vocal.config import VoiceConfig
-from sim.vocal.diva.tract import DivaTract
-from sim.vocal.tract import VocalTract
 from sim.vocal.voice import Voice
 
-TRACTS: dict[str, type[Voice]] = {cls.name: cls for cls in (VocalTract, DivaTract)}
-if tuple(TRACTS) != TRACT_NAMES:
-    raise ImportError(f"models/tracts.py lists {TRACT_NAMES}, the registry {tuple(TRACTS)}")
+__all__ = ["REGISTRY", "TRACTS", "load", "make_tract"]
+
+
+def load(name: str) -> type[Voice]:
+    """The tract class called `name`, imported now; ValueError naming the choices."""
+    if name not in REGISTRY:
+        raise ValueError(f"unknown vocal tract {name!r}: choose one of {list(REGISTRY)}")
+    module, _, class_name = REGISTRY[name].partition(":")
+    cls = getattr(importlib.import_module(module), class_name)
+    if not (isinstance(cls, type) and issubclass(cls, Voice)):
+        raise TypeError(f"{REGISTRY[name]} (vocal tract {name!r}) is not a Voice subclass")
+    return cls
 
 
 def make_tract(name: str, exact: bool, config: VoiceConfig, world: WorldConfig) -> Voice:
     """The vocal tract called `name` (its exact path if `exact`); ValueError naming the
     choices. DIVA without its installed data: DivaDataMissing, never another tract."""
-    if name not in TRACTS:
-        raise ValueError(f"unknown vocal tract {name!r}: choose one of {list(TRACTS)}")
-    return TRACTS[name](exact=exact, config=config, world=world)
+    return load(name)(exact=exact, config=config, world=world)

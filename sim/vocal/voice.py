@@ -43,6 +43,9 @@ class Voice(abc.ABC):
     name: str
     # What a video says of the sound it plays (experiments/video).
     sound_label: str
+    # What building the tract raises when the user's data it computes from is missing or
+    # unusable (DIVA's); none for a tract whose data ships with the project.
+    user_data_errors: tuple[type[Exception], ...] = ()
 
     def __init__(self, exact: bool, config: VoiceConfig, world: WorldConfig) -> None:
         self.exact = exact

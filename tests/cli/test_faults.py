@@ -95,10 +95,10 @@ def test_disk_full_during_a_run_is_one_line_and_it_resumes_to_the_same_trial(
     whole = tmp_path / "whole"
     run_trial(whole, TrialSettings(iterations=150, seed=3, checkpoint_every=30), progress=False)
     out = tmp_path / "full"
-    # config, log/README.txt, provenance and the checkpoint at iteration 0, then a log chunk
-    # and a checkpoint per 30 iterations: full while writing the checkpoint at 90 (after the
-    # one at 60 was moved aside as the previous one).
-    monkeypatch.setattr(storage, "open", FullDisk(out, allowed=9), raising=False)
+    # config, log/README.txt, provenance, the backend's record and the checkpoint at iteration
+    # 0, then a log chunk and a checkpoint per 30 iterations: full while writing the checkpoint
+    # at 90 (after the one at 60 was moved aside as the previous one).
+    monkeypatch.setattr(storage, "open", FullDisk(out, allowed=10), raising=False)
     assert main([*RUN, "--out", str(out)]) == 1
     line = _one_line(capsys.readouterr().err, "no space left on device", "--resume")
     assert f"cannot write {out / CHECKPOINT_FILE}" in line

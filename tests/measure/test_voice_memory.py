@@ -12,7 +12,7 @@ from learner.config import LearnerConfig
 from models.layout import VOICE_DIM
 from sim import Playroom
 from sim.config import world_preset
-from sim.vocal.productions import say
+from sim.vocal.vtl.productions import say
 
 
 def test_the_stored_commands_are_sorted_by_what_the_caregiver_hears():

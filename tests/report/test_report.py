@@ -21,7 +21,6 @@ from page_checks import check_explained
 from summary_checks import check_summary
 
 from experiments.analysis.curves import curve_rows, tool_numbers
-from experiments.analysis.log_chunks import CHUNK_IDENTITY_KEY, trial_identity
 from experiments.analysis.results import ReportError, collect
 from experiments.analysis.stats import (
     chi_square,
@@ -33,6 +32,7 @@ from experiments.analysis.stats import (
     welch,
 )
 from experiments.file_names import COMPARISON_FILE, EVAL_FILE, REPORT_FILE
+from experiments.log_layout import CHUNK_IDENTITY_KEY, trial_identity
 from experiments.measure.for_reports import room_measures
 from experiments.report import figures, paper
 from experiments.report.batch_report import write_report

@@ -12,7 +12,7 @@ import pytest
 
 from experiments import storage
 from experiments.analysis.curves import falling_rate_distance, grasp_rate_by_distance
-from experiments.file_names import CONFIG_FILE, LOG_DIR
+from experiments.file_names import BACKEND_FILE, CONFIG_FILE, LOG_DIR
 from experiments.report import stick_reach
 
 
@@ -94,14 +94,23 @@ def test_the_command_draws_the_figure_and_prints_the_table(tmp_path, capsys):
     assert "proposed physical return reach: 0.53 m" in printed
 
 
-def test_the_contact_limit_drawn_is_the_physical_backends():
-    # Read from the MJCF file as the compiled model the backend measures has it.
-    from sim.config import DEFAULT_WORLD
-    from sim.physics import PlayroomPhysics
-
-    physics = PlayroomPhysics.load(DEFAULT_WORLD)
-    sizes = physics.model.ptr.geom_size
-    expected = DEFAULT_WORLD.arm_length + sizes[physics.hand_geom, 0]
-    expected += sizes[physics.handle_geom, 0]
-    world = {"segment_lengths": list(DEFAULT_WORLD.segment_lengths)}
-    assert stick_reach.contact_limit({"world": world}) == pytest.approx(expected, abs=1e-12)
+def test_each_backend_is_drawn_at_the_reach_its_trials_recorded(tmp_path):
+    """Any backends, none known by name: a trial's backend.json gives its reach; a trial
+    written before the record, its config (experiments/backend_record.py)."""
+    batch = tmp_path / "batch"
+    world = {"segment_lengths": [0.25, 0.15, 0.1], "grasp_distance": 0.1}
+    world |= {"stick_start_handle": [-0.25, 0.0]}
+    recorded = {"grasp": "magnetic", "reach": 0.8, "solid": False, "pushes": False}
+    recorded["closed_form"] = False
+    for grasp, record in (("kinematic", None), ("magnetic", recorded)):
+        trial = batch / f"{grasp}-random-seed0000"
+        (trial / LOG_DIR).mkdir(parents=True)
+        config = {"trial": {"grasp": grasp, "seed": 0}, "world": world}
+        storage.write_json(trial / CONFIG_FILE, config)
+        if record is not None:
+            storage.write_json(trial / BACKEND_FILE, record)
+        log = _log(_many("arm", 0.251, 200, 40) + _many("arm", 0.535, 200, 40))
+        storage.write_table(trial / LOG_DIR / "iterations-00000000.parquet", log)
+    lines = stick_reach.distance_lines(stick_reach.batch_rates(batch))
+    reaches = {label.split(":")[0]: x for x, _, style, label in lines if style == "--"}
+    assert reaches == {"kinematic": pytest.approx(0.6), "magnetic": 0.8}

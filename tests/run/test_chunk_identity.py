@@ -14,11 +14,11 @@ from test_trial_integrity import task_failure
 from trial_logs import same_logs
 
 from experiments import storage
-from experiments.analysis.log_chunks import CHUNK_IDENTITY_KEY, chunk_identity
 from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.batches.runner import is_complete
 from experiments.cli.main import main
 from experiments.file_names import CONFIG_FILE, LOCK_FILE, LOG_DIR, LOG_KINDS
+from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_identity
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.run.trial_files import trial_identity

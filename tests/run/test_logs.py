@@ -12,23 +12,24 @@ import pytest
 from trial_logs import logs_of
 
 from experiments import storage
-from experiments.analysis.log_chunks import DuplicateChunkError
+from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.analysis.results import collect
 from experiments.batches.runner import is_complete
 from experiments.file_names import LOG_DIR, LOG_README_FILE
-from experiments.logs import SOURCE_COLUMNS, read_batch_logs, read_log
+from experiments.log_layout import (
+    GOAL_COLUMNS,
+    INTEREST_COLUMNS,
+    LEARNER_COLUMNS,
+    REACHED_COLUMNS,
+    SOURCE_COLUMNS,
+    DuplicateChunkError,
+)
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.run.trial_checks import check_logs
-from experiments.run.trial_files import (
-    GOAL_COLUMNS,
-    INTEREST_COLUMNS,
-    LEARNER_COLUMNS,
-    REACHED_COLUMNS,
-    TrialError,
-)
+from experiments.run.trial_files import TrialError
 from learner.config import learner_preset
 
 # Short trials: a bootstrap of 10 random commands, then goals, under active babbling.

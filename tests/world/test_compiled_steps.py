@@ -142,7 +142,7 @@ def test_positions_the_loop_cannot_write_in_place_are_refused():
     room = Playroom("physical", seed=0, config=PROJECT)
     positions = np.zeros((51, 5, 4))[:, :, :2]  # a strided view: rows not contiguous
     with pytest.raises(ValueError, match="C-contiguous"):
-        room.physics.control_steps(0, np.zeros((50, 3)), None, 0.1, positions, np.arange(4))
+        room.physics.control_steps(0, np.zeros((50, 3)), None, positions, np.arange(4))
 
 
 def _voice_after_an_arm_movement(compiled: bool, push_toy: bool) -> tuple[Playroom, object]:

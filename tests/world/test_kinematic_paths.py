@@ -19,7 +19,7 @@ from sim import Playroom
 from sim import events as ev
 from sim.config import DEFAULT_WORLD
 from sim.vocal.config import DEFAULT_VOICE
-from sim.vocal.productions import say
+from sim.vocal.vtl.productions import say
 
 STUDY_WORLD = dataclasses.replace(DEFAULT_WORLD, dmp="study", catch_rule="study")
 
@@ -28,7 +28,22 @@ def _twin_rooms(grasp: str, seed: int, config=DEFAULT_WORLD) -> tuple[Playroom, 
     fast = Playroom(grasp, seed=seed, config=config)
     stepped = Playroom(grasp, seed=seed, config=config)
     stepped.step_observers.append(lambda step, observation: None)
+    for room in (fast, stepped):
+        _record_holds(room)
     return fast, stepped
+
+
+def _record_holds(room: Playroom) -> None:
+    """Keep, in room.holds_spoken_of, what the caregiver is told is held after each arm
+    movement (the hand's and the stick's tip's holds), as both paths tell her."""
+    speak = room.caregiver.speak
+    room.holds_spoken_of = []  # type: ignore[attr-defined]
+
+    def recorded(holds, rng):
+        room.holds_spoken_of.append(holds)  # type: ignore[attr-defined]
+        return speak(holds, rng)
+
+    room.caregiver.speak = recorded  # type: ignore[method-assign]
 
 
 def _same(fast: Playroom, stepped: Playroom, space: str, m: np.ndarray) -> list[str]:
@@ -38,6 +53,7 @@ def _same(fast: Playroom, stepped: Playroom, space: str, m: np.ndarray) -> list[
     np.testing.assert_array_equal(a.positions, b.positions)
     np.testing.assert_array_equal(a.sound, b.sound)
     assert a.events == b.events
+    assert fast.holds_spoken_of == stepped.holds_spoken_of
     np.testing.assert_array_equal(fast.context(), stepped.context())
     np.testing.assert_array_equal(fast.physics.object_poses(), stepped.physics.object_poses())
     return a.kinds()

@@ -10,7 +10,7 @@ from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_DIM
 from models.world import Feedback
 from sim import Playroom
 from sim.dmp import voice_trajectory
-from sim.vocal.formant_map import FormantMap
+from sim.vocal.vtl.formant_map import FormantMap
 
 
 def test_the_map_at_the_sample_rows_is_the_whole_map_s_rows() -> None:

@@ -8,14 +8,15 @@ import vocaltractlab_cython as vtl
 
 from sim.caregiver import assign_words
 from sim.dmp import voice_trajectory
-from sim.vocal import formants as formants_mod
-from sim.vocal.articulators import default_articulators, speaker_shapes
-from sim.vocal.audio import synthesise, write_wav
+from sim.vocal.audio import write_wav
 from sim.vocal.config import DEFAULT_VOICE
-from sim.vocal.formants import FALLBACK_HZ, tract_formants, tube_formants
-from sim.vocal.productions import say, stored_distances
-from sim.vocal.tract import VocalTract
-from sim.vocal.words import (
+from sim.vocal.vtl import formants as formants_mod
+from sim.vocal.vtl.articulators import default_articulators, speaker_shapes
+from sim.vocal.vtl.audio import synthesise
+from sim.vocal.vtl.formants import FALLBACK_HZ, tract_formants, tube_formants
+from sim.vocal.vtl.productions import say, stored_distances
+from sim.vocal.vtl.tract import VocalTract
+from sim.vocal.vtl.words import (
     recognise,
     vowel_targets,
     word_distances,

@@ -12,8 +12,8 @@ from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
 from sim import events as ev
 from sim.config import world_preset
-from sim.vocal.productions import say
-from sim.vocal.words import word_distances, word_features
+from sim.vocal.vtl.productions import say
+from sim.vocal.vtl.words import word_distances, word_features
 
 # The world these tests were written for: the project preset (explicit, as Playroom() takes
 # the default preset, the study's).

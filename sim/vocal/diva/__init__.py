@@ -1,4 +1,4 @@
-"""DIVA's vocal tract as the study ran it ("diva" in sim/vocal/registry.py).
+"""DIVA's vocal tract as the study ran it ("diva" in models/tracts.py).
 
 - `fmfit`: DIVA's forward map in its 'audsom' mode (`diva_synth.m`, early 2017): articulators
   through tanh, then a fitted mixture of locally linear maps to F1-F3 in Hz.

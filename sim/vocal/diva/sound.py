@@ -54,7 +54,7 @@ def synthesise_formants(
     """(n_steps, 3) F1-F3 in Hz, one row per control step -> (waveform peaking at 1, rate).
 
     The steps share `duration_s`; the first and last are held `pad_s` before and after, with
-    the voice fading in and out over them, as VocalTractLab's audio does (sim/vocal/audio.py).
+    the voice fading in and out over them, as VocalTractLab's audio does (sim/vocal/vtl/audio.py).
     """
     formants_hz = np.asarray(formants_hz, dtype=float)
     if formants_hz.ndim != 2 or formants_hz.shape[1] != 3 or len(formants_hz) == 0:

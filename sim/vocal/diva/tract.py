@@ -1,4 +1,4 @@
-"""`DivaTract`: DIVA's vocal tract as the study used it ("diva" in sim/vocal/registry.py).
+"""`DivaTract`: DIVA's vocal tract as the study used it ("diva" in models/tracts.py).
 
 The study's code (c1c9c2d, environment/diva/diva.py; docs/protocol.md D13) fed DIVA 13
 articulators per frame: its 7 vocal DMP dimensions, clipped to [-1, 1], drive DIVA's articulators
@@ -17,7 +17,7 @@ import numpy as np
 from models.layout import N_ARTICULATORS
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.diva.data import installed_fit, map_digest
+from sim.vocal.diva.data import DivaDataError, DivaDataMissing, installed_fit, map_digest
 from sim.vocal.diva.fmfit import N_VOCAL_TRACT, FormantFit
 from sim.vocal.diva.sound import SOUND_LABEL, synthesise_formants
 from sim.vocal.voice import Voice
@@ -53,6 +53,7 @@ class DivaTract(Voice):
 
     name = "diva"
     sound_label = SOUND_LABEL
+    user_data_errors = (DivaDataMissing, DivaDataError)
 
     def __init__(
         self,

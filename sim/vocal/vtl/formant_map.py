@@ -1,7 +1,7 @@
 """The fast formant map: 7 articulators -> (log2 F1, log2 F2), a small MLP run in plain NumPy.
 
 Like DIVA's fitted formant model, a smooth map is fitted once (by `fit_voice_model`, with
-scikit-learn) on a large sample of the exact path (`sim.vocal.formants`) and stored as weights
+scikit-learn) on a large sample of the exact path (`sim.vocal.vtl.formants`) and stored as weights
 in data/formant_map.npz. Inference is a few matrix products: a (50, 7) batch costs a few tens of
 microseconds, against about 5 ms per frame for the exact path.
 """
@@ -124,6 +124,7 @@ def default_formant_map() -> FormantMap:
     """The stored fast map (data/formant_map.npz, written by fit_voice_model)."""
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.vtl.fitting.fit_voice_model` "
+            "to build it"
         )
     return FormantMap.load(DATA_FILE)

@@ -150,6 +150,7 @@ def default_articulators() -> ArticulatorModel:
     """The stored articulator model (data/articulators.npz, built by fit_voice_model)."""
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.vtl.fitting.fit_voice_model` "
+            "to build it"
         )
     return ArticulatorModel.load(DATA_FILE)

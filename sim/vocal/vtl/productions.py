@@ -1,5 +1,5 @@
 """The stored voice commands that say each word (data/productions.npz, found by
-`sim.vocal.produce`): `say(word)` is instant, and the caregiver's words sound through them.
+`sim.vocal.vtl.produce`): `say(word)` is instant, and the caregiver's words sound through them.
 """
 
 from __future__ import annotations
@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from sim.dmp import voice_trajectory
-from sim.vocal.audio import DEFAULT_DURATION_S, DEFAULT_PAD_S, synthesise
+from sim.vocal.audio import DEFAULT_DURATION_S, DEFAULT_PAD_S
+from sim.vocal.vtl.audio import synthesise
 
 DATA_FILE = Path(__file__).parent / "data" / "productions.npz"
 
@@ -19,7 +20,8 @@ DATA_FILE = Path(__file__).parent / "data" / "productions.npz"
 def _stored() -> dict[str, tuple[np.ndarray, float]]:
     if not DATA_FILE.exists():
         raise FileNotFoundError(
-            f"{DATA_FILE} is missing: run `python -m sim.vocal.fitting.fit_voice_model` to build it"
+            f"{DATA_FILE} is missing: run `python -m sim.vocal.vtl.fitting.fit_voice_model` "
+            "to build it"
         )
     with np.load(DATA_FILE) as d:
         return {

@@ -9,8 +9,8 @@ the fast formant map) come as close as possible to the word's perfect features:
 2. L-BFGS-B (bounds [-1, 1]) on the squared feature distance, from that guess and from
    perturbed copies of it; the best result wins.
 
-`fit_voice_model` stores the results in data/productions.npz (read by `sim.vocal.productions`);
-`compute_productions` redoes it.
+`fit_voice_model` stores the results in data/productions.npz (read by
+`sim.vocal.vtl.productions`); `compute_productions` redoes it.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from scipy.optimize import lsq_linear, minimize
 from models.layout import N_STEPS, SAMPLE_INDICES, VOICE_BASIS_FUNCTIONS, VOICE_DIM
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import rollout
-from sim.vocal.productions import DATA_FILE
-from sim.vocal.tract import VocalTract
+from sim.vocal.vtl.productions import DATA_FILE
+from sim.vocal.vtl.tract import VocalTract
 
 N_STARTS = 8  # optimisation starts per word: the linear guess and 7 perturbations of it
 START_NOISE = 0.2  # std of the perturbations, in parameter units

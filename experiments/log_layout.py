@@ -1,17 +1,43 @@
-"""Where a trial's log chunks lie (experiments/file_names.py names them).
+"""How a trial's logs lie on disk and what their rows hold: the one description that the
+writer (experiments/run/) writes by and every reader (experiments/analysis/logs.py, a resume's
+checks) reads by, below both stages so that neither imports the other for it.
 
-Each kind of log has its own folder, one chunk per checkpoint period:
-`log/iterations/chunk-NNNNNNNN.parquet`, `log/words/chunk-NNNNNNNN.parquet`. Trials written
-before the kinds had folders hold `log/iterations-NNNNNNNN.parquet` and
-`log/words-NNNNNNNN.parquet` side by side; both layouts are read here (a resume moves the old
-chunks into the folders: experiments/run/trial_checks.py, `move_old_chunks`). Read-only.
+Where the chunks lie (experiments/file_names.py names them). Each kind of log has its own
+folder, one chunk per checkpoint period: `log/iterations/chunk-NNNNNNNN.parquet`,
+`log/words/chunk-NNNNNNNN.parquet`. Trials written before the kinds had folders hold
+`log/iterations-NNNNNNNN.parquet` and `log/words-NNNNNNNN.parquet` side by side; both layouts
+are read here (a resume moves the old chunks into the folders: experiments/run/old_logs.py).
 
-Each chunk carries its trial's identity in its Parquet schema's metadata, as each checkpoint
-does in its own (`trial_identity`: the seed and a hash of the settings that make the trial), so
-that a chunk copied from another trial is told apart (`check_chunk`). It is written as the
-table's `attrs[CHUNK_IDENTITY_KEY]`, which pandas keeps there (JSON under b"PANDAS_ATTRS") and
-gives back to a reader of the chunk. Chunks written before they carried one are taken as their
-trial's, as they always were.
+Which trial a chunk belongs to. Each chunk carries its trial's identity in its Parquet schema's
+metadata, as each checkpoint does in its own (`trial_identity`: the seed and a hash of the
+settings that make the trial), so that a chunk copied from another trial is told apart
+(`check_chunk`). It is written as the table's `attrs[CHUNK_IDENTITY_KEY]`, which pandas keeps
+there (JSON under b"PANDAS_ATTRS") and gives back to a reader of the chunk. Chunks written
+before they carried one are taken as their trial's, as they always were.
+
+What the rows hold. Every row of both kinds starts with its source (SOURCE_COLUMNS: `trial`,
+the trial directory's name; `seed`; `backend`, the grasp backend; `voice`, the vocal tract), so
+that rows of several trials keep apart. The iterations log, one row per iteration
+(experiments/run/trial_files.py `log_row` and `learner_values` fill it):
+- iteration; motor_space ("arm" or "voice"); model (the chosen model, 0-based into
+  models.layout.MODELS, -1 during the bootstrap's random motor babbling);
+- stick_distance (m, the handle from the arm's base before the movement), stick_grasped,
+  stick_moved_by, toy1/2/3_moved_by ("hand", "stick", "push", "caregiver" or ""),
+  word_recognised, caregiver_said, diverged, stick_returned;
+- goal_0..goal_9 (GOAL_COLUMNS): the sensory goal the agent chose, in its model's 10D block (5
+  samples of x then 5 of y; for the sound, of F1 then F2); NaN during the bootstrap (no goal);
+- reached_0..reached_9 (REACHED_COLUMNS): the outcome in that same block of the feedback, as
+  the learner reads it (clipped to [-1, 1] under the study preset), so that the attempt's
+  competence is -sqrt(sum((goal_i - reached_i)^2)); NaN during the bootstrap;
+- interest_0..interest_9 (INTEREST_COLUMNS): each model's interest (learning progress,
+  learner/interest.py) when the iteration's model was chosen, i.e. before this iteration's
+  attempt; column k is model k of `model`. Kept under random babbling too, where it chooses
+  nothing.
+Goals, outcomes and interests are LEARNER_DTYPE, float32 (7 significant digits); rows written
+before they were logged hold NaN there. The words log, one row every 100 iterations: iteration
+and, per word, the best distance reached so far to it (inf before the voice was used).
+
+Pure functions of paths and dicts, reading only: no simulator, no learner.
 """
 
 from __future__ import annotations
@@ -21,6 +47,8 @@ import json
 import os
 import re
 from pathlib import Path
+
+import numpy as np
 
 from experiments import storage
 from experiments.config_file import identity_form
@@ -32,6 +60,31 @@ from experiments.file_names import (
     OLD_LOG_CHUNK_PATTERN,
     log_chunk_name,
 )
+from models.layout import BLOCK_DIM, MODELS
+
+# The columns that say which trial a row comes from, first in every row.
+SOURCE_COLUMNS = ("trial", "seed", "backend", "voice")
+# The learner's columns of the iterations log: the goal and the outcome in the chosen model's
+# sensory block, and every model's interest (what each holds: above).
+GOAL_COLUMNS = tuple(f"goal_{i}" for i in range(BLOCK_DIM))
+REACHED_COLUMNS = tuple(f"reached_{i}" for i in range(BLOCK_DIM))
+INTEREST_COLUMNS = tuple(f"interest_{k}" for k in range(len(MODELS)))
+LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
+# Stored as float32: 7 significant digits are plenty to plot and average them, at half the size
+# of float64 (random goals hardly compress). The other columns keep their types.
+LEARNER_DTYPE = np.float32
+
+
+def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
+    """The source columns of a trial's rows, from its directory and config."""
+    trial = config["trial"]
+    return {
+        "trial": Path(trial_dir).resolve().name,
+        "seed": int(trial["seed"]),
+        "backend": str(trial["grasp"]),
+        "voice": str(trial.get("voice", "vtl")),
+    }
+
 
 _CHUNK = re.compile(re.escape(LOG_CHUNK_PREFIX) + r"(?P<start>[0-9]{8})\.parquet")
 _OLD_CHUNK = re.compile(OLD_LOG_CHUNK_PATTERN)

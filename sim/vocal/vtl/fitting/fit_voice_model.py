@@ -1,6 +1,6 @@
-"""Regenerate the voice's data files in sim/vocal/data/ (seeded; `make voice-model`).
+"""Regenerate the voice's data files in sim/vocal/vtl/data/ (seeded; `make voice-model`).
 
-    python -m sim.vocal.fitting.fit_voice_model [--samples N] [--seed S] [--workers W]
+    python -m sim.vocal.vtl.fitting.fit_voice_model [--samples N] [--seed S] [--workers W]
         [--max-iter I]
 
 1. articulators.npz: PCA articulators of the VTL speaker; prints the explained variance.
@@ -24,13 +24,13 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from sim.vocal.articulators import ArticulatorModel, build_articulator_model
 from sim.vocal.config import DEFAULT_VOICE
-from sim.vocal.formant_map import ROUNDS, FormantMap, fit_formant_map
-from sim.vocal.formants import tract_formants
-from sim.vocal.produce import compute_productions, save_productions
-from sim.vocal.tract import VocalTract
-from sim.vocal.words import (
+from sim.vocal.vtl.articulators import ArticulatorModel, build_articulator_model
+from sim.vocal.vtl.formant_map import ROUNDS, FormantMap, fit_formant_map
+from sim.vocal.vtl.formants import tract_formants
+from sim.vocal.vtl.produce import compute_productions, save_productions
+from sim.vocal.vtl.tract import VocalTract
+from sim.vocal.vtl.words import (
     compute_vowel_targets,
     recognise,
     save_vowel_targets,

@@ -1,9 +1,12 @@
-"""`VocalTract`: VocalTractLab's vocal tract ("vtl" in sim/vocal/registry.py), the study's.
+"""`VocalTract`: VocalTractLab's vocal tract ("vtl" in models/tracts.py), this project's.
+
+The study ran DIVA (sim/vocal/diva/); this articulatory synthesizer is the project's own voice
+and the default one (docs/protocol.md §7).
 
 Articulator values (7 per frame) in [-1, 1] go to formants (log2 Hz) either through the fast
 fitted map (default; microseconds per movement) or the exact path (VocalTractLab area function
 and lossless-tube resonances; about 5 ms per frame). Audio is VocalTractLab's synthesis
-(sim/vocal/audio.py). What the world does with formants is common to every tract
+(sim/vocal/vtl/audio.py). What the world does with formants is common to every tract
 (sim/vocal/voice.py).
 """
 
@@ -12,21 +15,21 @@ from __future__ import annotations
 import numpy as np
 
 from sim.config import DEFAULT_WORLD, WorldConfig
-from sim.vocal.articulators import ArticulatorModel, default_articulators
-from sim.vocal.audio import synthesise
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.formant_map import FormantMap, default_formant_map
-from sim.vocal.formants import tract_formants
-from sim.vocal.productions import synthesise_word
 from sim.vocal.voice import Voice
-from sim.vocal.words import vowel_targets
+from sim.vocal.vtl.articulators import ArticulatorModel, default_articulators
+from sim.vocal.vtl.audio import synthesise
+from sim.vocal.vtl.formant_map import FormantMap, default_formant_map
+from sim.vocal.vtl.formants import tract_formants
+from sim.vocal.vtl.productions import synthesise_word
+from sim.vocal.vtl.words import vowel_targets
 
 
 class VocalTract(Voice):
     """The agent's vocal tract, VocalTractLab's.
 
     exact=False uses the fast formant map; exact=True the exact path, whose failed frames
-    (VTL error, no resonance) get `sim.vocal.formants.FALLBACK_HZ` and are counted in
+    (VTL error, no resonance) get `sim.vocal.vtl.formants.FALLBACK_HZ` and are counted in
     `n_fallbacks`.
     """
 
@@ -56,7 +59,7 @@ class VocalTract(Voice):
         return None if self.exact else self.formant_map.at_rows(artic, rows)
 
     def vowel_targets(self) -> dict[str, np.ndarray]:
-        """The speaker's own vowels (sim/vocal/words.py), not the study's Hz values."""
+        """The speaker's own vowels (sim/vocal/vtl/words.py), not the study's Hz values."""
         return vowel_targets(self.config)
 
     def audio(self, artic_traj: np.ndarray) -> tuple[np.ndarray, int]:
@@ -64,5 +67,5 @@ class VocalTract(Voice):
         return synthesise(artic_traj, articulators=self.articulators)
 
     def word_audio(self, word: str) -> tuple[np.ndarray, int]:
-        """The stored production of the word (sim/vocal/produce.py) through VocalTractLab."""
+        """The stored production of the word (sim/vocal/vtl/produce.py) through VocalTractLab."""
         return synthesise_word(word)
