@@ -10,7 +10,7 @@ registry is reported on its own terms without a line changed here.
 
 Trials written before backend.json existed lack it. They ran one of the two backends of that
 time, and `recorded_before` computes, from the trial's config.json, the record that backend
-writes now, to the bit (tests/world/test_backend_contract.py checks it against the backends
+writes now, to the bit (tests/sim/test_backend_contract.py checks it against the backends
 themselves): the one place that still knows those two by name, for old trials only.
 
 `study_reach` is not a backend's declaration but the study's yardstick, the same for every

@@ -38,7 +38,7 @@ def weighted_choice(rng: np.random.Generator, p: np.ndarray) -> int:
     of p (a third of a choice's cost, every iteration). p (n,) non-negative, summing to 1.
 
     Generator.choice's own arithmetic: the normalised cumulative sum, searched for one uniform
-    draw. tests/agent/test_same_draws.py holds it to Generator.choice draw by draw.
+    draw. tests/learner/test_same_draws.py holds it to Generator.choice draw by draw.
     """
     cdf = p.cumsum()
     cdf /= cdf[-1]
@@ -50,7 +50,7 @@ def window_progress(ring: np.ndarray, n: int, half: int) -> float:  # pragma: no
     """|mean of the newest `half` (<= 128) competences - mean of the `half` before them| of a
     model whose attempt k sits at ring[k % len(ring)], n attempts made; 0 where half is 0. The
     means are ndarray.mean's arithmetic (NumPy's sum, then the division), compiled: every
-    iteration updates one model's progress (tests/agent/test_pairwise_sum.py)."""
+    iteration updates one model's progress (tests/learner/test_pairwise_sum.py)."""
     if half == 0:
         return 0.0
     recent = np.empty(2 * half)  # attempts n - 2 half .. n - 1, oldest first

@@ -6,7 +6,7 @@
 multiple of 8 then added one by one; all of it added to the reduction's identity, 0.0. (Beyond
 128 values NumPy sums the two halves recursively: not compiled here, where recursive functions
 loaded from numba's cache crashed.) Compiled code that adds in this order gives NumPy's sums
-where a NumPy call would cost more than the sum (tests/agent/test_pairwise_sum.py holds it to
+where a NumPy call would cost more than the sum (tests/learner/test_pairwise_sum.py holds it to
 `np.add.reduce` for every length, natively and without AVX-512).
 """
 

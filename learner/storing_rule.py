@@ -15,7 +15,7 @@ Two rules (LearnerConfig.storing_rule; docs/protocol.md §11):
 Both are compiled (numba; every iteration runs one, and as a dozen NumPy calls on arrays of
 60 values it was mostly call overhead). The study's rule does arithmetic: its kernel adds in
 the order NumPy's reductions of these shapes add, so the spreads are NumPy's to the last bit
-(tests/agent/test_storing_rule.py holds it to the NumPy expression).
+(tests/learner/test_storing_rule.py holds it to the NumPy expression).
 """
 
 from __future__ import annotations

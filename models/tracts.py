@@ -6,7 +6,7 @@ tract's class only when one is built (as Gymnasium registers its environments). 
 not beside the tracts, because `sim.config` reads it and sim/vocal/ imports `sim.config`.
 
 Adding a tract: its module (a `sim.vocal.voice.Voice` subclass whose `name` is its key here)
-and one line in `REGISTRY`; tests/world/test_tract_contract.py then runs it.
+and one line in `REGISTRY`; tests/sim/vocal/test_tract_contract.py then runs it.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ and the caregiver's hand as the physical backend writes them (each operation rou
 own, no fast-math), and reads positions and contact sensors from the same arrays. The sensors
 are off during a control step's first substeps (`disable_flags_view`): they feed nothing back
 into the dynamics, and are read only after the last.
-tests/world/test_compiled_steps.py holds it to the step-by-step Python loop bit for bit.
+tests/sim/test_compiled_steps.py holds it to the step-by-step Python loop bit for bit.
 
 MuJoCo's library is the one its Python package ships (found beside `mujoco/__init__.py`); where
 it is not found, `AVAILABLE` is False and the room steps in Python.

@@ -4,7 +4,7 @@ sim/events.movement_events, compiled (numba).
 Why compiled: the test runs after nearly every movement, and as eight NumPy calls on a (51, 4, 2)
 array it was mostly call overhead (10 us, 4% of a kinematic iteration). The arithmetic is
 NumPy's: the offset from the start, its length as the root of x*x + y*y with every operation
-rounded on its own, compared with the threshold (tests/world/test_movement_events.py holds it to
+rounded on its own, compared with the threshold (tests/sim/test_same_numbers_faster.py holds it to
 the NumPy expression).
 """
 

@@ -12,7 +12,7 @@ Each path returns a `MovementOutcome`. Everything around a movement that does no
 path (the caregiver hearing the agent before it; after it, which objects moved and by what, her
 word, her putting a toy down, the backend's release) is done once, by `Playroom` (sim/playroom.py):
 a rule of the caregiver's (sim/caregiver.py) or the experimenter's is written once, whatever the
-path. tests/world/test_kinematic_paths.py holds the closed form to the stepped path, bit for bit.
+path. tests/sim/test_kinematic_paths.py holds the closed form to the stepped path, bit for bit.
 """
 
 from __future__ import annotations

@@ -104,7 +104,7 @@ class PlayroomTask(control.Task):
         A backend with compiled stepping (the physical one) runs the steps in compiled code
         between the contacts it acts on, where MuJoCo's library is found and `compiled_steps`
         is True (the default); otherwise each step runs here in Python, the reference the
-        compiled loop is tested against (tests/world/test_compiled_steps.py).
+        compiled loop is tested against (tests/sim/test_compiled_steps.py).
         """
         from sim.compiled_steps import AVAILABLE
 

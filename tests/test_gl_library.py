@@ -105,7 +105,7 @@ def test_the_non_rendering_tests_pass_there(broken_egl):
     env, _ = broken_egl
     result = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider",
-         "tests/world/test_envs.py", "-k", "refuse"],
+         "tests/sim/envs/test_envs.py", "-k", "refuse"],
         env=env, capture_output=True, text=True, cwd=ROOT,
     )  # fmt: skip
     assert result.returncode == 0, result.stdout[-3000:]

@@ -28,4 +28,4 @@ def test_only_make_test_slow_installs_it_and_requires_its_checks_to_run():
     assert '".[rl]"' not in _dry_run("test") and '".[rl]"' not in _dry_run("run")
     slow = _dry_run("test-slow")
     assert '-e ".[rl]"' in slow
-    assert "PLAYROOM_RL_REQUIRED=1" in slow  # tests/world/test_env_sb3.py fails, not skips
+    assert "PLAYROOM_RL_REQUIRED=1" in slow  # tests/sim/envs/test_env_sb3.py fails, not skips

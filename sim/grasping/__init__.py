@@ -11,5 +11,5 @@
 - `physical`: grasping through MuJoCo contacts and welds.
 
 Adding a backend: a module with a `GraspBackend` subclass and one line in
-`registry.REGISTRY`; tests/world/test_backend_contract.py runs every registered backend.
+`registry.REGISTRY`; tests/sim/test_backend_contract.py runs every registered backend.
 """

@@ -162,7 +162,7 @@ class ArmMovement:
 class ClosedForm(GraspBackend):
     """A backend whose movements are closed-form geometry: the room computes an unobserved
     movement whole from these, with the same result, to the last bit, as stepping the backend
-    through the dm_control task (tests/world/test_kinematic_paths.py)."""
+    through the dm_control task (tests/sim/test_kinematic_paths.py)."""
 
     @abc.abstractmethod
     def arm_movement(

@@ -5,7 +5,7 @@ at once (the room's fast path; the arm's rules compiled in kinematic_kernel.py).
 follows its targets exactly and objects move only when held or carried, so a movement is
 geometry: the hand's path is the forward kinematics of the 50 targets, a rule fires at the
 first step at which a distance drops below its threshold, and held objects follow the hand (or
-the held stick's tip) from that step on. tests/world/test_kinematic_paths.py compares the two
+the held stick's tip) from that step on. tests/sim/test_kinematic_paths.py compares the two
 forms on thousands of commands, sample by sample and event by event: change a rule in both
 forms, and run it.
 """

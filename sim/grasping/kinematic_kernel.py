@@ -6,8 +6,8 @@ Why compiled: the rules are a few dozen operations on arrays of 50 steps and 4 o
 NumPy each operation cost a Python call (40 us a movement, a sixth of a kinematic iteration).
 Every number here is computed as NumPy computed it: the same operations in the same order, each
 rounded on its own (no fused multiply-add), and distances by the C library's `hypot`, which is
-NumPy's. tests/world/test_kinematic_paths.py holds the closed form to the step-by-step rules
-and tests/world/test_same_numbers_faster.py the distances to NumPy's.
+NumPy's. tests/sim/test_kinematic_paths.py holds the closed form to the step-by-step rules
+and tests/sim/test_same_numbers_faster.py the distances to NumPy's.
 """
 
 from __future__ import annotations

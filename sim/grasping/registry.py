@@ -9,7 +9,7 @@ module fails to import breaks only itself. The vocal tracts' registry has the sa
 (models/tracts.py, sim/vocal/registry.py).
 
 Adding a backend: its module (a `sim.grasping.base.GraspBackend` subclass whose `name` is its
-key here) and one line below; tests/world/test_backend_contract.py then runs it.
+key here) and one line below; tests/sim/test_backend_contract.py then runs it.
 """
 
 from __future__ import annotations

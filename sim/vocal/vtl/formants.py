@@ -15,7 +15,7 @@ nearly closes the tract, so they make a discontinuous map of the articulators. I
    the areas, hence so do F1 and F2.
 
 Against VTL's transfer-function peaks (8192 samples) of the speaker's /o u i e y/ this agrees
-within about 11% (worst: F2 of /e/); see tests/world/test_vocal.py.
+within about 11% (worst: F2 of /e/); see tests/sim/vocal/test_vocal.py.
 
 When VTL raises an error, or D has fewer than two sign changes below MAX_FREQUENCY, or a value
 is not finite, the frame gets FALLBACK_HZ (a uniform 17.5 cm tube: 500, 1500 Hz) and its `ok`

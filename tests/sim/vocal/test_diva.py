@@ -19,7 +19,7 @@ from sim.vocal.diva.fmfit import FormantFit
 from sim.vocal.diva.sound import synthesise_formants
 from sim.vocal.diva.tract import DivaTract
 
-NOTEBOOK = Path(__file__).parents[1] / "data" / "diva-study-notebook.json"
+NOTEBOOK = Path(__file__).parents[2] / "data" / "diva-study-notebook.json"
 
 
 def formants_by_the_equations(fit: FormantFit, x: np.ndarray) -> np.ndarray:

@@ -1,6 +1,6 @@
 """The grasp backends and vocal tracts come from their registries, and every entry point takes
 one default backend and one default preset (models/presets.py, sim/grasping/names.py). What
-every registered backend must do: tests/world/test_backend_contract.py."""
+every registered backend must do: tests/sim/test_backend_contract.py."""
 
 from __future__ import annotations
 

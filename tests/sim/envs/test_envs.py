@@ -60,7 +60,7 @@ class TestMovementEnvIsADmEnv(test_utils.EnvironmentTestMixin, unittest.TestCase
 def _checked_quietly(env: gymnasium.Env) -> None:
     # Gymnasium's checker warns about what it only recommends: here every warning fails. Its
     # render check makes the environment in each declared mode, "human" included, which needs a
-    # display: tests/world/test_env_rendering.py runs it whole under Xvfb, and checks the frames.
+    # display: tests/sim/envs/test_env_rendering.py runs it whole under Xvfb, and checks the frames.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env, skip_render_check=True)

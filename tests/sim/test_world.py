@@ -13,6 +13,7 @@ from sim import Playroom
 from sim import events as ev
 from sim.config import DEFAULT_WORLD, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
+from sim.grasping.names import GRASPS
 from sim.kinematics import hand_positions
 from sim.physics import PlayroomPhysics
 
@@ -20,7 +21,7 @@ from sim.physics import PlayroomPhysics
 # the default preset, the study's).
 PROJECT = world_preset("project")
 
-BACKENDS = ["kinematic", "physical"]
+BACKENDS = list(GRASPS)  # every registered backend
 # Toys parked in ring 3, away from every scripted path below.
 PARKED_TOYS = np.array([[-0.75, -0.55], [-0.15, -0.9], [-0.8, 0.5]])
 
