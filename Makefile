@@ -111,7 +111,7 @@ ablations: replicate
 # to a process, so that each file's fixtures are made once.
 PYTEST := $(BIN)/python -m pytest -q -n auto --dist loadfile
 
-## test: lint, then the test suite (under 4 minutes on 2 cores, installation included)
+## test: lint, then the test suite (its current time: README.md; every timing: docs/speed.md)
 test: lint
 	$(PYTEST)
 

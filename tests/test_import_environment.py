@@ -1,4 +1,4 @@
-"""Importing the packages changes no environment variable (README, "The world"), whatever the
+"""Importing the packages changes no environment variable (docs/usage.md), whatever the
 libraries they import do at theirs: threadpoolctl (through scipy.io) sets KMP_DUPLICATE_LIB_OK,
 which would hide two OpenMP runtimes in a process with torch, and Gymnasium sets
 PYGAME_HIDE_SUPPORT_PROMPT."""

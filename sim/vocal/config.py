@@ -17,7 +17,7 @@ class VoiceConfig:
     vowels: tuple[str, ...] = ("o", "u", "i", "e", "y")
     words: tuple[str, ...] = ("oey", "uye", "iuo", "eyu", "eou", "yeo")
     # The study's target formants (F1, F2) in Hz. Our targets are the VocalTractLab speaker's
-    # own vowels (see `sim.vocal.vtl.words`); these are kept for comparison in the README.
+    # own vowels (see `sim.vocal.vtl.words`); these are kept for comparison in docs/voice.md.
     # Rows (vowel, F1, F2); a tuple so that the config stays hashable.
     study_vowel_hz: tuple[tuple[str, float, float], ...] = (
         ("o", 500.0, 900.0),

@@ -250,7 +250,7 @@ def test_a_batch_says_when_a_trial_waits_for_another_writer(tmp_path, client):
 def test_stored_profiles_hold_what_the_readme_says(installed_generated_map):
     smoke, demo, paper = (load_spec(p) for p in ("smoke", "demo", "paper"))
     # The study reference of their reports: the study's own at its scale, smaller for batches
-    # of short trials (the README's profile table says which).
+    # of short trials (experiments/batches/profiles/ says which).
     assert (smoke.study_reference_commands, demo.study_reference_commands) == (300, 3000)
     for name in ("paper", "replication", "comparison", "replication-diva"):
         assert load_spec(name).study_reference_commands == 30000, name
