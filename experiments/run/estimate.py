@@ -6,8 +6,8 @@ grow faster, with the square of the iterations: the memory's nearest-neighbour q
 more row each iteration, and every checkpoint rewrites all the rows. So a trial ten times the
 study's length costs about a hundred times its time, and a billion iterations decades.
 
-The estimate rests on the costs measured on the development machine (docs/speed.md, its bench figures
-at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
+The estimate rests on the costs measured on the development machine (docs/speed.md, its bench
+figures at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
 measured. Another machine scales the time, not the disk. A trial that will not fit on its disk
 is refused before anything is written, `--quiet` or not (`check_fits`).
 """
@@ -30,8 +30,8 @@ SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
 # The inverse query scans the chosen model's rows, at most one per iteration so far: 77 us at
 # 80000 rows (docs/speed.md, `playroom bench learner`), in proportion to them.
 QUERY_SECONDS_PER_ROW = 77e-6 / 80000
-# Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to each
-# checkpoint (586 measured at 20000 kinematic iterations; 611 in issue 31: 416 MB at 681000).
+# Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to
+# each checkpoint (586 measured at 20000 kinematic iterations; 611 in issue 31: 416 MB at 681000).
 LOG_BYTES_PER_ITERATION = 120
 CHECKPOINT_BYTES_PER_ITERATION = 620
 # How fast a checkpoint is written: an 11 MB one took 19 to 23 ms.
