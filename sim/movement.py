@@ -74,7 +74,9 @@ def closed_form_movement(
     holds = _NOTHING_HELD
     still = False
     if movement == ARM:
-        arm = closed.arm_movement(controls.T, poses[0], poses[1:, :2])
+        # (3, N_STEPS), C-ordered as the compiled rules were compiled for (no copy: the
+        # targets were made so, then transposed)
+        arm = closed.arm_movement(np.ascontiguousarray(controls.T), poses[0], poses[1:, :2])
         positions[1:], events, holds = arm.positions, arm.events, arm.holds
         poses[0] = arm.stick_pose
     else:

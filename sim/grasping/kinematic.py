@@ -70,6 +70,7 @@ class KinematicGrasp(ClosedForm):
     name = "kinematic"
     physics_class = KinematicPhysics
     solid = False
+    _arm_moved = False  # whether a stepped movement moved the arm from rest (`release`)
 
     # Arm movements: the grasp and catch rules, stepped ------------------------------------
     def before_step(
@@ -77,6 +78,7 @@ class KinematicGrasp(ClosedForm):
     ) -> list[ev.Event]:
         d = physics.data.ptr
         d.qpos[physics.arm_qpos] = joint_targets
+        self._arm_moved = True
         mujoco.mj_kinematics(physics.model.ptr, d)
         events = self._attach_by_distance(physics, step)
         self._carry(physics)
@@ -142,7 +144,11 @@ class KinematicGrasp(ClosedForm):
     def release(self, physics: PlayroomPhysics) -> None:
         self.hand_holds = None
         self.stick_holds = None
-        arm_to_rest(physics)
+        # Only the stepped path moves the arm (the closed form computes the hand's path without
+        # it, and no dynamics give it a velocity or a control): at rest, it stays as it is.
+        if self._arm_moved:
+            arm_to_rest(physics)
+            self._arm_moved = False
 
     # Arm movements: the same rules in closed form -----------------------------------------
     def arm_movement(
