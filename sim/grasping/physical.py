@@ -136,6 +136,12 @@ class PhysicalGrasp(GraspBackend):
         record their parting as its toy's outcome. Then everything is still again."""
         if not self.config.settle_between_movements:
             return
+        # `advance` begins with mj_step2, which integrates the forces mj_step1 computed last:
+        # those of the held, welded state before the release and the arm's return to rest.
+        # Computed again for the room as it is now, as a movement's start computes them
+        # (sim/playroom.py's placements end in mj_forward); without it the stale contact
+        # forces flung the stick up to 0.9 m in a settle (issue 32's first settle run).
+        mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
         physics.advance(SETTLE_PHYSICS_STEPS)
         physics.stop_objects()
         arm_to_rest(physics)
