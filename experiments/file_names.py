@@ -1,9 +1,9 @@
 """Every file a trial directory or a batch directory holds, by name, in one place.
 
 A trial directory (experiments/run/trial.py writes it) holds the trial itself: its settings,
-checkpoints, logs, provenance and lock (TRIAL_ENTRIES); everything else in it was derived from
-the trial at some iteration (its evaluation, its timing) and is moved aside into
-`stale-at-NNNNNNNN/` when the trial is extended. A batch directory holds one trial directory
+checkpoints, memory segments, logs, provenance and lock (TRIAL_ENTRIES); everything else in it
+was derived from the trial at some iteration (its evaluation, its timing) and is moved aside
+into `stale-at-NNNNNNNN/` when the trial is extended. A batch directory holds one trial directory
 per trial, and the pages written about it.
 """
 
@@ -15,6 +15,11 @@ CHECKPOINT_FILE = "checkpoint.npz"
 PREVIOUS_CHECKPOINT_FILE = "checkpoint.prev.npz"
 # Where a damaged newest checkpoint is kept when a resume falls back past it.
 DAMAGED_CHECKPOINT_FILE = "checkpoint.damaged.npz"
+# The models' memories, each row written once: one segment per checkpoint period that stored
+# rows, memory/rows-NNNNNNNN.npz, NNNNNNNN the iteration the period starts at; a checkpoint
+# names the newest segment it is made of (experiments/run/memory_segments.py).
+MEMORY_DIR = "memory"
+MEMORY_SEGMENT_PREFIX = "rows-"
 LOG_DIR = "log"
 # The logs, each kind in its own folder of LOG_DIR, one chunk per checkpoint period:
 # log/iterations/chunk-NNNNNNNN.parquet and log/words/chunk-NNNNNNNN.parquet, NNNNNNNN the
@@ -42,6 +47,7 @@ TRIAL_ENTRIES = (
     CHECKPOINT_FILE,
     PREVIOUS_CHECKPOINT_FILE,
     DAMAGED_CHECKPOINT_FILE,
+    MEMORY_DIR,
     LOG_DIR,
     LOCK_FILE,
     PROVENANCE_FILE,
@@ -78,3 +84,9 @@ SUMMARY_CSV_FILE = "summary.csv"
 def log_chunk_name(start: int) -> str:
     """The name of the log chunk that starts at iteration `start`, in its kind's folder."""
     return f"{LOG_CHUNK_PREFIX}{start:08d}.parquet"
+
+
+def memory_segment_name(start: int) -> str:
+    """The name of the memory segment of the checkpoint period that starts at iteration
+    `start`, in MEMORY_DIR."""
+    return f"{MEMORY_SEGMENT_PREFIX}{start:08d}.npz"

@@ -239,11 +239,15 @@ class Agent:
 
     # ------------------------------------------------------------------ checkpoints
 
-    def state_dict(self) -> dict[str, np.ndarray]:
+    def state_dict(self, rows_from: dict[int, int] | None = None) -> dict[str, np.ndarray]:
         """Everything to continue bit-identically: plain arrays and 0-d arrays, for np.savez.
 
         Keys: 'config' and 'rng' (JSON strings), 't', 'bootstrap_order', 'heard', 'n_heard',
-        'interest.*', and 'model{number}.motor' / 'model{number}.key' per model.
+        'interest.*', and 'model{number}.motor' / 'model{number}.key' per model: its rows
+        from row `rows_from[number]` on (all of them by default). The rows are only ever
+        appended: a trial's checkpoint stores those its earlier ones did not, apart
+        (`memory_rows`), and its own rows from there on, none; `load_state_dict` takes every
+        row back.
         """
         state: dict[str, np.ndarray] = {
             "config": np.array(self.config.to_json()),
@@ -257,10 +261,23 @@ class Agent:
         }
         for key, value in self.interest.state_dict().items():
             state[f"interest.{key}"] = value
-        for spec, model in zip(self.specs, self.models, strict=True):
-            for key, value in model.state_dict().items():
-                state[f"model{spec.number}.{key}"] = value
+        state.update(self.memory_rows(rows_from or {}))
         return state
+
+    def memory_sizes(self) -> dict[int, int]:
+        """The rows each model has stored, by model number."""
+        return {
+            spec.number: len(model) for spec, model in zip(self.specs, self.models, strict=True)
+        }
+
+    def memory_rows(self, rows_from: dict[int, int]) -> dict[str, np.ndarray]:
+        """Each model's rows from row `rows_from[number]` on (0 for a model not named), under
+        the keys of `state_dict`: 'model{number}.motor' and 'model{number}.key'."""
+        rows = {}
+        for spec, model in zip(self.specs, self.models, strict=True):
+            for key, value in model.state_dict(rows_from.get(spec.number, 0)).items():
+                rows[f"model{spec.number}.{key}"] = value
+        return rows
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore a `state_dict()` (also as loaded by np.load). The config must match."""

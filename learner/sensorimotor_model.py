@@ -178,9 +178,15 @@ class SensorimotorModel:
         i, _ = self._forward.nearest(np.concatenate((m, c_i)))
         return self.sensory[i].copy()
 
-    def state_dict(self) -> dict[str, np.ndarray]:
-        """{'motor': (n, motor_dim), 'key': (n, c_dim + 10)}: plain float64 arrays."""
-        return {"motor": self._motor[: self._n].copy(), "key": self._inverse.state_dict()["rows"]}
+    def state_dict(self, start: int = 0) -> dict[str, np.ndarray]:
+        """{'motor': (n - start, motor_dim), 'key': (n - start, c_dim + 10)}: the rows stored
+        from row `start` on (all of them by default), plain float64 copies. Rows are only ever
+        appended, so a checkpoint writes each once: those stored since the last one
+        (experiments/run/memory_segments.py)."""
+        return {
+            "motor": self._motor[start : self._n].copy(),
+            "key": self._inverse.rows[start:].copy(),
+        }
 
     def load_state_dict(self, state: dict[str, np.ndarray]) -> None:
         motor = np.asarray(state["motor"], dtype=np.float64)

@@ -45,7 +45,7 @@ from experiments.file_names import (
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run import stop_requests
+from experiments.run import memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
@@ -88,7 +88,8 @@ def is_complete(trial_dir: Path) -> bool:
     a lost log chunk) is run again, which evaluates it again or reports the damage."""
     try:
         config = storage.read_json(trial_dir / CONFIG_FILE)
-        _, meta = storage.read_arrays(trial_dir / CHECKPOINT_FILE)
+        # Read whole, with the memory segments it names (a damaged one is run again).
+        _, meta = memory_segments.read_checkpoint(trial_dir / CHECKPOINT_FILE)
         summary = storage.read_json(trial_dir / EVAL_FILE)
         if not meta.get("finished") or not isinstance(summary, dict):
             return False

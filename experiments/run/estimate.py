@@ -1,10 +1,13 @@
 """What a trial will cost, said before it starts: its time, and the disk its files take.
 
 The disk a trial holds at its end grows with its iterations: a row of logs each, and the
-learner's memory, which every checkpoint holds (two are kept). Its time and the bytes it writes
-grow faster, with the square of the iterations: the memory's nearest-neighbour query scans one
-more row each iteration, and every checkpoint rewrites all the rows. So a trial ten times the
-study's length costs about a hundred times its time, and a billion iterations decades.
+learner's memory, each row of it written once, in the segment of the checkpoint period that
+stored it (experiments/run/memory_segments.py), beside two checkpoints of a fixed size. The
+bytes it writes grow as the disk does, in proportion to the iterations (before segments, every
+checkpoint rewrote every row: they grew with the square). Its time grows faster, with the
+square of the iterations: the memory's nearest-neighbour query scans one more row each
+iteration. So a trial ten times the study's length costs about a hundred times its time, and a
+billion iterations decades.
 
 The estimate rests on the costs measured on the development machine (docs/speed.md, its bench
 figures at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
@@ -20,7 +23,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, LOG_DIR, PREVIOUS_CHECKPOINT_FILE
+from experiments.file_names import (
+    CHECKPOINT_FILE,
+    LOG_DIR,
+    MEMORY_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+)
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_files import TrialError
 
@@ -31,9 +39,14 @@ SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
 # 80000 rows (docs/speed.md, `playroom bench learner`), in proportion to them.
 QUERY_SECONDS_PER_ROW = 77e-6 / 80000
 # Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to
-# each checkpoint (586 measured at 20000 kinematic iterations; 611 in issue 31: 416 MB at 681000).
+# the memory's segments (585 measured over iterations 1000 to 20000 of a kinematic trial, seed 0,
+# none during the study's bootstrap; 611 in issue 31's checkpoints, 416 MB at 681000: rounded up
+# from the larger, as a disk that is too small fails a trial late).
 LOG_BYTES_PER_ITERATION = 120
-CHECKPOINT_BYTES_PER_ITERATION = 620
+MEMORY_BYTES_PER_ITERATION = 620
+# Bytes of a checkpoint without the memory's rows: 38.9 KB measured, at 3000 and at 20000
+# iterations alike.
+CHECKPOINT_BYTES = 40e3
 # How fast a checkpoint is written: an 11 MB one took 19 to 23 ms.
 CHECKPOINT_BYTES_PER_SECOND = 0.5e9
 # Trials longer than the study's 80000 iterations state their estimate before they start.
@@ -45,23 +58,24 @@ class TrialCosts:
     """What running a trial from an iteration to its end costs."""
 
     seconds: float
-    disk_bytes: float  # its logs and two checkpoints at the end
-    written_bytes: float  # every checkpoint written on the way, in all
+    disk_bytes: float  # its logs, memory segments and two checkpoints at the end
+    written_bytes: float  # every checkpoint and memory segment written on the way, in all
 
 
 def trial_costs(settings: TrialSettings, start: int = 0) -> TrialCosts:
     """The costs of running `settings`' trial from iteration `start` to its end."""
     n, s = settings.iterations, min(start, settings.iterations)
-    # The rows scanned over iterations s..n-1, about sum(i) = (n^2 - s^2) / 2; the checkpoint
-    # at iteration k holds k iterations' rows, one every `checkpoint_every`, and one at the end.
+    # The rows scanned over iterations s..n-1, about sum(i) = (n^2 - s^2) / 2. Each iteration's
+    # rows are written once; a checkpoint every `checkpoint_every`, and one at the end.
     rows = (n * n - s * s) / 2
-    written = CHECKPOINT_BYTES_PER_ITERATION * (rows / settings.checkpoint_every + (n - s))
+    checkpoints = -(-(n - s) // settings.checkpoint_every)
+    written = MEMORY_BYTES_PER_ITERATION * (n - s) + CHECKPOINT_BYTES * checkpoints
     seconds = (
         (n - s) * _per_iteration(settings.grasp)
         + rows * QUERY_SECONDS_PER_ROW
         + written / CHECKPOINT_BYTES_PER_SECOND
     )
-    disk = n * (LOG_BYTES_PER_ITERATION + 2 * CHECKPOINT_BYTES_PER_ITERATION)
+    disk = n * (LOG_BYTES_PER_ITERATION + MEMORY_BYTES_PER_ITERATION) + 2 * CHECKPOINT_BYTES
     return TrialCosts(seconds, disk, written)
 
 
@@ -77,8 +91,8 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
         f"estimated from the development machine's costs: "
         f"{1000 * _per_iteration(settings.grasp):.2g} ms an iteration, "
         f"plus {1e9 * QUERY_SECONDS_PER_ROW:.2g} ns per row of memory searched, "
-        f"{LOG_BYTES_PER_ITERATION} B of logs and {CHECKPOINT_BYTES_PER_ITERATION} B per "
-        "checkpoint an iteration"
+        f"{LOG_BYTES_PER_ITERATION} B of logs and {MEMORY_BYTES_PER_ITERATION} B of memory an "
+        f"iteration, {size(CHECKPOINT_BYTES)} a checkpoint"
     )
     if free is not None and need > free:
         raise TrialError(
@@ -90,8 +104,8 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
     free_text = "?" if free is None else size(free)
     return (
         f"this trial: ~{duration(costs.seconds)}, ~{size(costs.disk_bytes)} of logs and "
-        f"checkpoints on {out_dir} ({free_text} free); its checkpoints, each rewriting every "
-        f"row, write ~{size(costs.written_bytes)} in all ({basis})"
+        f"checkpoints on {out_dir} ({free_text} free); its checkpoints, each writing the "
+        f"memory's new rows, write ~{size(costs.written_bytes)} in all ({basis})"
     )
 
 
@@ -101,8 +115,9 @@ def _per_iteration(grasp: str) -> float:
 
 
 def _progress(out_dir: Path) -> tuple[int, int]:
-    """(iteration of the newest readable checkpoint, bytes of checkpoints and logs) of a trial
-    to be resumed; (0, 0) where there is none yet. A resume checks the trial itself."""
+    """(iteration of the newest readable checkpoint, bytes of checkpoints, memory segments and
+    logs) of a trial to be resumed; (0, 0) where there is none yet. A resume checks the trial
+    itself."""
     iteration = 0
     for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
         try:
@@ -111,7 +126,8 @@ def _progress(out_dir: Path) -> tuple[int, int]:
         except (storage.CorruptFileError, KeyError, TypeError, ValueError):
             continue
     files = [out_dir / CHECKPOINT_FILE, out_dir / PREVIOUS_CHECKPOINT_FILE]
-    files += [p for p in (out_dir / LOG_DIR).rglob("*") if p.is_file()]
+    for folder in (LOG_DIR, MEMORY_DIR):
+        files += [p for p in (out_dir / folder).rglob("*") if p.is_file()]
     return iteration, sum(p.stat().st_size for p in files if p.is_file())
 
 

@@ -1,9 +1,10 @@
 """One trial: the Model Babbling agent playing in one room, written to a directory that
 survives being killed (its files: experiments/run/trial_files.py).
 
-Each file is written atomically, and a log chunk is always written before the checkpoint that
-covers it, so a run killed at any moment resumes from its last checkpoint and rewrites the same
-chunks: the final memory and logs equal those of an uninterrupted run.
+Each file is written atomically, and a log chunk, like the segment of the memory's new rows
+(experiments/run/memory_segments.py), is always written before the checkpoint that covers it,
+so a run killed at any moment resumes from its last checkpoint and rewrites the same chunks and
+segments: the final memory and logs equal those of an uninterrupted run.
 
 One process writes into a trial directory at a time (experiments/run/lock.py). Resuming with more
 iterations than the trial was asked for extends it: the result equals a run asked for the
@@ -44,7 +45,7 @@ from experiments.log_layout import (
     chunk_path,
     source_of,
 )
-from experiments.run import estimate, stop_requests
+from experiments.run import estimate, memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, is_litter, prepare_resume, remove_litter
@@ -93,6 +94,8 @@ class Trial:
             self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
             self.elapsed: float | None = None  # seconds of the last `run_trial`
             self.start_iteration = 0
+            # What the memory's segments hold (none yet): each checkpoint writes the rest.
+            self.memory = memory_segments.MemoryOnDisk({}, None, 0)
             if resume:
                 self._resume()
             readme = self.dir / LOG_DIR / LOG_README_FILE
@@ -171,9 +174,15 @@ class Trial:
 
     # Checkpoints --------------------------------------------------------------------------
     def _save_checkpoint(self) -> None:
+        # The rows the memory stored since the last checkpoint, in a segment of their own, on
+        # disk before the checkpoint that names it; the checkpoint holds the rest.
+        memory = memory_segments.write_segment(
+            self.dir, self.agent, self.memory, self.iteration, self.identity
+        )
         room_state = self.room.get_state()
         # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
-        arrays = {f"agent/{k}": v for k, v in self.agent.state_dict().items()}
+        state = self.agent.state_dict(rows_from=memory.rows)
+        arrays = {f"{memory_segments.AGENT}{k}": v for k, v in state.items()}
         arrays["room/physics"] = room_state.pop("physics")
         arrays["best_word_distance"] = self.best_word_distance
         meta = {
@@ -183,12 +192,14 @@ class Trial:
             "counts": self.counts,
             # Whose checkpoint it is: one copied into another trial is refused there.
             "identity": self.identity,
+            memory_segments.MEMORY_KEY: memory.meta(),
         }
         newest = self.dir / CHECKPOINT_FILE
         if newest.exists():
             # Killed between these two lines, the trial still has the previous checkpoint.
             os.replace(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
         storage.write_arrays(newest, arrays, meta)
+        self.memory = memory
 
     def _resume(self) -> None:
         """Load the newest usable checkpoint (its logs checked before anything is changed),
@@ -200,7 +211,10 @@ class Trial:
             self.iteration = int(meta["iteration"])
             self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
             self.counts = dict(meta["counts"])
-        drop_logs_past(self.dir, self.iteration)  # the lost work's: rewritten by the run
+            self.memory = memory_segments.on_disk(meta)
+        # The lost work's, past the checkpoint: rewritten by the run.
+        drop_logs_past(self.dir, self.iteration)
+        memory_segments.drop_segments_past(self.dir, self.iteration)
         self._extend_if_asked()
 
     def _extend_if_asked(self) -> None:

@@ -2,9 +2,13 @@
 
 A trial directory holds:
 - `config.json`: every setting (trial, world, voice, learner), the package version, the seed;
-- `checkpoint.npz`: agent memory, room state and every random generator state, rewritten
+- `checkpoint.npz`: the agent's state, the room's and every random generator's, rewritten
   every `checkpoint_every` iterations and at the end, with the one before it kept beside it
   as `checkpoint.prev.npz`: a damaged newest checkpoint costs at most two periods;
+- `memory/rows-NNNNNNNN.npz`: the rows the models' memories stored over the checkpoint period
+  starting at iteration NNNNNNNN, each row written once, before the checkpoint that names the
+  segments it is made of (experiments/run/memory_segments.py; checkpoints written before
+  segments hold every row themselves);
 - `log/iterations/chunk-NNNNNNNN.parquet`: one row per iteration (motor space, chosen model,
   events, goal, outcome, every model's interest), one file per checkpoint period, starting at
   iteration NNNNNNNN;
@@ -36,6 +40,7 @@ import numpy as np
 from experiments import storage
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
 from experiments.log_layout import identity_text, trial_identity
+from experiments.run import memory_segments
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from models.layout import BLOCK_DIM, TOYS, context_indices
@@ -199,18 +204,22 @@ def restore_checkpoint(
     *,
     config: dict,
 ) -> dict:
-    """Load a trial's checkpoint into `agent` and `room`; returns the checkpoint's metadata
-    with 'best_word_distance' added. CorruptFileError if it cannot be read or restored;
-    TrialError if it belongs to another trial than `config`'s."""
+    """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`;
+    returns the checkpoint's metadata with 'best_word_distance' added. CorruptFileError if it
+    or a segment cannot be read or restored; TrialError if either belongs to another trial
+    than `config`'s."""
     path = Path(trial_dir) / name
     if not path.exists():
         raise storage.CorruptFileError(f"{path} is missing")
     arrays, meta = storage.read_arrays(path)
     check_identity(path, meta, config)
     try:
-        agent_state = {
-            k.removeprefix("agent/"): v for k, v in arrays.items() if k.startswith("agent/")
-        }
+        arrays = memory_segments.with_rows(path, arrays, meta)
+    except memory_segments.ForeignSegmentError as exc:
+        raise TrialError(str(exc)) from None
+    try:
+        prefix = memory_segments.AGENT
+        agent_state = {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
         agent.load_state_dict(agent_state)
         room.set_state({**meta["room"], "physics": arrays["room/physics"]})
         meta["best_word_distance"] = arrays["best_word_distance"].copy()

@@ -22,6 +22,7 @@ from experiments.measure import study_measure
 from experiments.measure.for_reports import room_measures
 from experiments.report.batch_report import write_report
 from experiments.report.figures import FigureFile
+from experiments.run.memory_segments import read_checkpoint
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 
@@ -107,8 +108,9 @@ def test_disk_full_during_a_run_is_one_line_and_it_resumes_to_the_same_trial(
     monkeypatch.undo()
     assert main([*RUN, "--out", str(out), "--resume"]) == 0
     same_logs(out, whole)
-    arrays_a, meta_a = storage.read_arrays(out / CHECKPOINT_FILE)
-    arrays_b, meta_b = storage.read_arrays(whole / CHECKPOINT_FILE)
+    # Whole: the checkpoint's own arrays and every model's rows from its memory segments.
+    arrays_a, meta_a = read_checkpoint(out / CHECKPOINT_FILE)
+    arrays_b, meta_b = read_checkpoint(whole / CHECKPOINT_FILE)
     assert meta_a == meta_b and sorted(arrays_a) == sorted(arrays_b)
     for key in arrays_a:
         assert (arrays_a[key] == arrays_b[key]).all(), key

@@ -7,9 +7,8 @@ import subprocess
 import sys
 import threading
 
-import numpy as np
 import pytest
-from trial_logs import same_logs
+from trial_states import same_state
 
 from experiments import storage
 from experiments.batches.runner import run_and_evaluate
@@ -37,17 +36,6 @@ HOLD_LOCK = (
 
 def _run_cli(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([*PLAYROOM, *args], capture_output=True, text=True)
-
-
-def _same_trial(a, b) -> None:
-    """Same checkpoint arrays and metadata, same logs."""
-    arrays_a, meta_a = storage.read_arrays(a / CHECKPOINT_FILE)
-    arrays_b, meta_b = storage.read_arrays(b / CHECKPOINT_FILE)
-    assert sorted(arrays_a) == sorted(arrays_b)
-    for key in arrays_a:
-        np.testing.assert_array_equal(arrays_a[key], arrays_b[key], err_msg=key)
-    assert meta_a == meta_b
-    same_logs(a, b)
 
 
 @pytest.fixture
@@ -129,7 +117,7 @@ def test_resume_with_more_iterations_equals_the_longer_run_from_the_start(tmp_pa
     longer = TrialSettings(iterations=250, seed=2, checkpoint_every=100)
     run_trial(short, longer, resume=True, progress=False, notify=notices.append)
     run_trial(whole, longer, progress=False)
-    _same_trial(short, whole)
+    same_state(short, whole)
     assert storage.read_json(short / CONFIG_FILE) == storage.read_json(whole / CONFIG_FILE)
     # The shorter run's evaluation is moved aside, not mixed with the longer trial.
     assert not (short / EVAL_FILE).exists()
@@ -184,7 +172,7 @@ def test_a_truncated_newest_checkpoint_falls_back_to_the_previous_one(tmp_path, 
     notice = [line for line in result.stderr.splitlines() if "previous checkpoint" in line]
     assert len(notice) == 1 and "iteration 30" in notice[0]
     assert (out / DAMAGED_CHECKPOINT_FILE).read_bytes() == damaged
-    _same_trial(out, whole_run)
+    same_state(out, whole_run)
 
 
 def test_a_newest_checkpoint_lost_while_being_replaced_falls_back(tmp_path, whole_run):
@@ -193,7 +181,7 @@ def test_a_newest_checkpoint_lost_while_being_replaced_falls_back(tmp_path, whol
     result = _run_cli(*args, "--out", str(out), "--resume")
     assert result.returncode == 0, result.stderr
     assert "previous checkpoint" in result.stderr
-    _same_trial(out, whole_run)
+    same_state(out, whole_run)
 
 
 def test_both_checkpoints_damaged_is_one_line_and_destroys_nothing(tmp_path):

@@ -22,11 +22,13 @@ def _free(monkeypatch, free: int) -> None:
     monkeypatch.setattr(shutil, "disk_usage", lambda path: Usage(10**15, 10**15 - free, free))
 
 
-def test_disk_grows_with_the_iterations_and_checkpoint_writes_with_their_square():
+def test_disk_and_checkpoint_writes_grow_with_the_iterations_time_with_their_square():
     one = estimate.trial_costs(TrialSettings(iterations=100000, checkpoint_every=1000))
     two = estimate.trial_costs(TrialSettings(iterations=200000, checkpoint_every=1000))
-    assert two.disk_bytes == pytest.approx(2 * one.disk_bytes)
-    assert two.written_bytes == pytest.approx(4 * one.written_bytes, rel=0.01)
+    assert two.disk_bytes == pytest.approx(2 * one.disk_bytes, rel=0.01)
+    # Each row of memory is written once (experiments/run/memory_segments.py), not by every
+    # checkpoint again (issue 34).
+    assert two.written_bytes == pytest.approx(2 * one.written_bytes, rel=0.01)
     assert two.seconds > 2 * one.seconds  # the query scans more rows as the memory grows
     slower = estimate.trial_costs(TrialSettings(grasp="physical", iterations=100000))
     assert slower.seconds > one.seconds and slower.disk_bytes == one.disk_bytes
@@ -52,7 +54,9 @@ def test_the_issues_billion_iterations_are_refused_with_quiet(tmp_path, monkeypa
     run = ["run", "--out", str(out), "--iterations", "1000000000", "--quiet"]
     assert main(run) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "TB" in err[0] and "100 GB free" in err[0], err
+    # 740 GB: 740 B an iteration, the memory's rows written once (two checkpoints held them
+    # all before issue 34: 1.36 TB).
+    assert len(err) == 1 and "needs ~740 GB" in err[0] and "100 GB free" in err[0], err
     assert not out.exists()
 
 

@@ -10,7 +10,7 @@ import subprocess
 import sys
 
 import pytest
-from trial_logs import same_logs
+from trial_states import same_state
 
 from experiments import storage
 from experiments.batches.runner import is_complete, run_and_evaluate
@@ -55,15 +55,6 @@ def _copy(base, tmp_path):
 def _contents(out) -> dict:
     """Every file of a trial directory and its bytes (the lock file names its last holder)."""
     return {p: p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != LOCK_FILE}
-
-
-def _same_trial(a, b) -> None:
-    arrays_a, meta_a = storage.read_arrays(a / CHECKPOINT_FILE)
-    arrays_b, meta_b = storage.read_arrays(b / CHECKPOINT_FILE)
-    assert sorted(arrays_a) == sorted(arrays_b) and meta_a == meta_b
-    for key in arrays_a:
-        assert (arrays_a[key] == arrays_b[key]).all(), key
-    same_logs(a, b)
 
 
 def _cli(capsys, *argv: str) -> tuple[int, list[str]]:
@@ -135,7 +126,7 @@ def test_killed_between_the_first_log_chunk_and_its_checkpoint_resumes_to_the_sa
     os.replace(out / PREVIOUS_CHECKPOINT_FILE, out / CHECKPOINT_FILE)
     assert storage.read_arrays(out / CHECKPOINT_FILE)[1]["iteration"] == 0
     run_trial(out, SETTINGS, resume=True, progress=False)
-    _same_trial(out, base)
+    same_state(out, base)
 
 
 # 2. A checkpoint carries its trial's identity ------------------------------------------------
@@ -269,7 +260,7 @@ def test_a_missing_newest_checkpoint_is_said_to_be_missing_not_damaged(base, tmp
     fallback = [n for n in notices if "previous checkpoint" in n]
     assert len(fallback) == 1 and "is missing" in fallback[0] and "iteration 200" in fallback[0]
     assert "damaged" not in fallback[0] and not (out / DAMAGED_CHECKPOINT_FILE).exists()
-    _same_trial(out, base)
+    same_state(out, base)
 
 
 @pytest.mark.parametrize("previous", ["damaged", "missing"])

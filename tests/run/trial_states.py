@@ -1,0 +1,28 @@
+"""Trials compared whole: their newest checkpoints read with every model's rows (joined from the
+memory segments they name, experiments/run/memory_segments.py), and their logs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from trial_logs import same_logs
+
+from experiments.file_names import CHECKPOINT_FILE
+from experiments.run.memory_segments import read_checkpoint
+from experiments.run.settings import TrialSettings
+
+# A trial whose memory grows from its first iteration (the project preset learns from its
+# bootstrap; the study's stores nothing before iteration 1000): 4 checkpoint periods.
+SEGMENTED = TrialSettings(iterations=400, seed=3, checkpoint_every=100, preset="project")
+
+
+def same_state(a: Path, b: Path) -> None:
+    """Same newest checkpoint, read whole (arrays, their types, metadata), same logs."""
+    arrays_a, meta_a = read_checkpoint(Path(a) / CHECKPOINT_FILE)
+    arrays_b, meta_b = read_checkpoint(Path(b) / CHECKPOINT_FILE)
+    assert sorted(arrays_a) == sorted(arrays_b) and meta_a == meta_b
+    for key in arrays_a:
+        np.testing.assert_array_equal(arrays_a[key], arrays_b[key], err_msg=key)
+        assert arrays_a[key].dtype == arrays_b[key].dtype, key
+    same_logs(a, b)
