@@ -14,8 +14,9 @@ key here) and one line below; tests/sim/test_backend_contract.py then runs it.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
+
+from models.registry import load_registered
 
 if TYPE_CHECKING:
     from sim.grasping.base import GraspBackend
@@ -31,8 +32,7 @@ REGISTRY: dict[str, str] = {
 def load(name: str) -> type[GraspBackend]:
     """The backend class registered as `name`, its module imported now; ValueError naming
     the choices."""
-    target = REGISTRY.get(name)
-    if target is None:
-        raise ValueError(f"unknown grasp backend {name!r}: choose one of {list(REGISTRY)}")
-    module, _, attribute = target.partition(":")
-    return getattr(importlib.import_module(module), attribute)
+    from sim.grasping.base import GraspBackend  # (MuJoCo: only when a room is built)
+
+    backend = load_registered(REGISTRY, name, "grasp backend", GraspBackend)
+    return cast("type[GraspBackend]", backend)

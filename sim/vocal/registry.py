@@ -8,8 +8,9 @@ registry has the same shape (sim/grasping/registry.py).
 
 from __future__ import annotations
 
-import importlib
+from typing import cast
 
+from models.registry import load_registered
 from models.tracts import REGISTRY, TRACTS
 from sim.config import WorldConfig
 from sim.vocal.config import VoiceConfig
@@ -20,13 +21,7 @@ __all__ = ["REGISTRY", "TRACTS", "load", "make_tract"]
 
 def load(name: str) -> type[Voice]:
     """The tract class called `name`, imported now; ValueError naming the choices."""
-    if name not in REGISTRY:
-        raise ValueError(f"unknown vocal tract {name!r}: choose one of {list(REGISTRY)}")
-    module, _, class_name = REGISTRY[name].partition(":")
-    cls = getattr(importlib.import_module(module), class_name)
-    if not (isinstance(cls, type) and issubclass(cls, Voice)):
-        raise TypeError(f"{REGISTRY[name]} (vocal tract {name!r}) is not a Voice subclass")
-    return cls
+    return cast("type[Voice]", load_registered(REGISTRY, name, "vocal tract", Voice))
 
 
 def make_tract(name: str, exact: bool, config: VoiceConfig, world: WorldConfig) -> Voice:
