@@ -3,7 +3,9 @@ lists them in its help without loading a simulator (experiments/bench/sections.p
 
 from __future__ import annotations
 
-SECTION_NAMES = ("trial", "learner", "world", "tracking", "voice", "render", "emulated")
+SECTION_NAMES = ("trial", "learner", "world", "tracking", "voice", "render", "emulated", "long")
+# Run only when named (minutes): `playroom bench` alone leaves them out.
+ON_REQUEST = ("long",)
 # What each section measures, for the command line's help.
 SECTION_HELP = {
     "trial": "whole trials of both backends against 500 bare mj_step (fastest of 3 runs each, "
@@ -16,4 +18,6 @@ SECTION_HELP = {
     "voice": "the fitted formant map against the exact path; the vocal part of an iteration",
     "render": "offscreen rendering (needs OpenGL: MUJOCO_GL)",
     "emulated": "trial and learner again under the other CPU class's settings (a second process)",
+    "long": "only when named: one trial of 10^6 iterations; cost per iteration and checkpoint "
+    "bytes near 80000 and near its end, peak memory (~4 min)",
 }

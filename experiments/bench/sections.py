@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 
 from experiments.bench.idle import idle_figures
-from experiments.bench.names import SECTION_NAMES
+from experiments.bench.names import ON_REQUEST, SECTION_NAMES
 from experiments.bench.tracking import hand_tracking_errors
 from experiments.bench.trials import (
     replication_pair_seconds,
@@ -323,6 +323,13 @@ def emulated_section(
         raise RuntimeError(f"the emulated bench failed (exit code {child.returncode})")
 
 
+def long_section() -> Iterator[tuple[str, float, str]]:
+    """One trial of 10^6 iterations (experiments/bench/long.py)."""
+    from experiments.bench.long import long_figures
+
+    yield from long_figures()
+
+
 def machine_line() -> str:
     """Which machine and which kernels the figures come from."""
     from experiments import provenance
@@ -353,6 +360,7 @@ SECTIONS: dict[str, Callable[[], Iterator[tuple[str, float, str]]]] = {
     "voice": voice_figures,
     "render": render_section,
     "emulated": emulated_section,
+    "long": long_section,
 }
 
 # The command line's list (experiments/bench/names.py) names exactly these, in this order.
@@ -363,6 +371,6 @@ if tuple(SECTIONS) != SECTION_NAMES:
 def run_bench(sections: list[str] | None = None) -> None:
     """Print every figure of the chosen sections (all by default)."""
     print(machine_line(), flush=True)
-    for name in sections or list(SECTIONS):
+    for name in sections or [s for s in SECTIONS if s not in ON_REQUEST]:
         for figure, value, unit in SECTIONS[name]():
             print(f"{figure}: {value:.4g} {unit}", flush=True)

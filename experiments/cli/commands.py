@@ -287,13 +287,14 @@ def cmd_bench(args: argparse.Namespace) -> None:
             render_skipped = True
     else:
         gl.without_rendering()
+    from experiments.bench.names import ON_REQUEST
     from experiments.bench.sections import SECTIONS, run_bench
 
     unknown = [s for s in args.section if s not in SECTIONS]
     if unknown:
         raise UsageError(f"unknown bench section(s) {unknown}: choose from {sorted(SECTIONS)}")
     if render_skipped:
-        sections = [s for s in SECTIONS if s != "render"]
+        sections = [s for s in SECTIONS if s != "render" and s not in ON_REQUEST]
     run_bench(sections)
 
 

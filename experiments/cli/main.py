@@ -10,7 +10,7 @@ import sys
 import textwrap
 
 from experiments.batches.stored import stored_profiles
-from experiments.bench.names import SECTION_HELP, SECTION_NAMES
+from experiments.bench.names import ON_REQUEST, SECTION_HELP, SECTION_NAMES
 from experiments.cli.args import (
     Parser,
     VersionAction,
@@ -310,7 +310,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "section",
         nargs="*",
-        help=f"sections to run, of {', '.join(SECTION_NAMES)} (default: all)",
+        help=f"sections to run, of {', '.join(SECTION_NAMES)} "
+        f"(default: all but {', '.join(ON_REQUEST)})",
     )
     p.set_defaults(func=cmd_bench)
     return parser

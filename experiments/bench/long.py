@@ -1,0 +1,79 @@
+"""`playroom bench long`: the cost of development longer than the study's, measured on one
+trial of 10^6 iterations (issue 34): its cost per iteration and the bytes a checkpoint writes
+near 80000 iterations and near its end, from the memory segments it writes every 1000
+iterations (their write times and sizes), and its peak memory. One trial in a process of its
+own, run as `playroom run` runs it (study preset, kinematic, seed 0), in a temporary directory.
+
+Why from the segments: a trial writes one per checkpoint period, so their times are the
+trial's own clock at every 1000 iterations, with nothing added to the trial to measure it.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+from experiments.file_names import CHECKPOINT_FILE, MEMORY_DIR
+
+LONG_ITERATIONS = 1_000_000
+NEAR = 80_000  # the study's length: the reference point
+WINDOW = 8_000  # iterations each cost is averaged over
+PERIOD = 1_000  # the trial's checkpoint period: one segment each
+# Issue 34's targets: cost and checkpoint bytes at 10^6 over 80000, peak memory.
+COST_RATIO_TARGET = 2.0
+BYTES_RATIO_TARGET = 1.5
+PEAK_MEMORY_TARGET_MB = 4096
+# The child prints its own peak resident memory after the trial (kB on Linux).
+_CHILD = (
+    "import resource, sys; from experiments.cli.main import main; rc = main(sys.argv[1:]); "
+    "print('peak_kb', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); sys.exit(rc)"
+)
+
+
+def long_figures(
+    iterations: int = LONG_ITERATIONS, near: int = NEAR, window: int = WINDOW
+) -> Iterator[tuple[str, float, str]]:
+    """(name, value, unit) of one trial of `iterations`: cost per iteration over the `window`
+    iterations from `near` and up to the last period, the checkpoint bytes at both, and the
+    trial's peak memory."""
+    with tempfile.TemporaryDirectory(prefix="playroom-bench-long-") as scratch:
+        out = Path(scratch) / "trial"
+        command = [sys.executable, "-c", _CHILD, "run", "--out", str(out)]
+        command += ["--iterations", str(iterations), "--checkpoint-every", str(PERIOD)]
+        command += ["--preset", "study", "--seed", "0"]
+        done = subprocess.run([*command, "--quiet"], capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"the long trial failed: {done.stderr.strip()[-500:]}")
+        peak_kb = int(done.stdout.split("peak_kb")[-1].split()[0])
+        late = iterations - PERIOD - window  # the last segment is the last period's
+        early_cost, late_cost = (_cost(out, start, window) for start in (near, late))
+        early_bytes, late_bytes = (_checkpoint_bytes(out, start) for start in (near, late))
+    yield f"long_cost_per_iteration_near_{near}", early_cost * 1e3, "ms"
+    yield f"long_cost_per_iteration_near_{iterations}", late_cost * 1e3, "ms"
+    ratio = late_cost / early_cost
+    yield "long_cost_ratio", ratio, f"ratio (target <= {COST_RATIO_TARGET:g})"
+    yield f"long_checkpoint_bytes_near_{near}", early_bytes / 1e3, "kB"
+    yield f"long_checkpoint_bytes_near_{iterations}", late_bytes / 1e3, "kB"
+    bytes_ratio = late_bytes / early_bytes
+    yield "long_checkpoint_bytes_ratio", bytes_ratio, f"ratio (target <= {BYTES_RATIO_TARGET:g})"
+    yield "long_peak_memory", peak_kb / 1024, f"MB (target < {PEAK_MEMORY_TARGET_MB})"
+
+
+def _segment(trial: Path, start: int) -> Path:
+    return trial / MEMORY_DIR / f"rows-{start:08d}.npz"
+
+
+def _cost(trial: Path, start: int, window: int) -> float:
+    """Seconds per iteration between the segments written at `start` and `start + window`."""
+    first, last = _segment(trial, start), _segment(trial, start + window)
+    return (os.path.getmtime(last) - os.path.getmtime(first)) / window
+
+
+def _checkpoint_bytes(trial: Path, start: int) -> int:
+    """What one checkpoint writes there: the period's segment and a checkpoint (the final one's
+    size: a checkpoint's size does not grow with the trial)."""
+    return _segment(trial, start).stat().st_size + (trial / CHECKPOINT_FILE).stat().st_size
