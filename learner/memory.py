@@ -29,9 +29,16 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from learner.quantized_scan import BLOCK_ROWS, CODE_MAX, screen_query, store_row
+from learner.code_tree import FANOUT, LEAF_ROWS, build_tree, tree_levels
+from learner.indexed_screen import screen_query
+from learner.quantized_scan import BLOCK_ROWS, CODE_MAX, store_row
 
 _INITIAL_CAPACITY = 1024
+# Rows of the smallest tree (learner/code_tree.py). A memory builds its first trees at twice
+# this, and then screens block by block fewer than this past its trees: a memory of a
+# study-length trial (at most about 50000 rows) or of `playroom bench`'s learner (80000) holds
+# none and is screened as before trees.
+TREE_ROWS = 2**16
 
 
 def squared_distances(rows: np.ndarray, query: np.ndarray) -> np.ndarray:
@@ -68,12 +75,19 @@ def _scale_for(max_abs: float) -> float:
 class NearestNeighbourMemory:
     """Rows of `dim` floats, appended one at a time, with exact nearest-neighbour queries."""
 
-    def __init__(self, dim: int, capacity: int = _INITIAL_CAPACITY) -> None:
+    def __init__(
+        self, dim: int, capacity: int = _INITIAL_CAPACITY, tree_rows: int = TREE_ROWS
+    ) -> None:
         if not isinstance(dim, int | np.integer) or dim <= 0:
             raise ValueError(f"memory dimension must be a positive integer, got {dim!r}")
+        if tree_rows < BLOCK_ROWS or tree_rows % BLOCK_ROWS or tree_rows & (tree_rows - 1):
+            raise ValueError(
+                f"tree_rows must be a power of two and a multiple of {BLOCK_ROWS}, got {tree_rows}"
+            )
         self._dim = int(dim)
         self._n = 0
         self._scale = 1.0  # grid step is scale / CODE_MAX
+        self._tree_rows = int(tree_rows)
         self._allocate(max(int(capacity), 1))
 
     @property
@@ -107,6 +121,8 @@ class NearestNeighbourMemory:
         # _code_from's arithmetic for one row, compiled (every iteration stores a row or two).
         if not store_row(self._rows, self._codes, n, values, self._scale):
             self._code_from(n)  # beyond the grid: widened, every row re-coded
+        elif self._n >= self._next_trees:
+            self._grow_trees()
 
     def extend(self, rows: ArrayLike) -> None:
         """Add rows (k, dim) at once, as k appends would."""
@@ -123,6 +139,11 @@ class NearestNeighbourMemory:
         self._rows[n : n + k] = rows
         self._n = n + k
         self._code_from(n)
+
+    def trees(self) -> list[tuple[int, int]]:
+        """The trees' runs of rows (first row, rows), oldest first (learner/code_tree.py); the
+        rows after the last are screened block by block."""
+        return list(self._runs)
 
     def nearest(self, query: ArrayLike) -> tuple[int, float]:
         """(index of the nearest row, Euclidean distance), as `brute_force_nearest` answers.
@@ -154,21 +175,18 @@ class NearestNeighbourMemory:
         """(index of the nearest row, its distance, or None where a single candidate made
         computing it unnecessary) for a checked query."""
         n = self._n
-        count = screen_query(
-            self._codes,
-            n,
-            q,
-            CODE_MAX / self._scale,
-            self._block_squares,
-            self._block_min,
-            self._candidates,
-        )
+        trees = (self._tail, self._tree_table, self._levels, self._order, self._leaf_codes)
+        trees += (self._boxes,)
+        scratch = (self._block_squares, self._block_min, self._candidates, self._squares)
+        count = screen_query(self._codes, self._rows, n, q, self._scale, trees, scratch)
         if count < 0:  # far outside the grid: scanned exactly
             return brute_force_nearest(self._rows[:n], q)
         if count == 1:
             return int(self._candidates[0]), None
         # In increasing index order, so argmin's first minimum is the lowest index of a tie.
         candidates = self._candidates[:count]
+        if self._runs:  # the trees' candidates come in their leaves' order
+            candidates = np.sort(candidates)
         squared = squared_distances(self._rows[candidates], q)
         j = int(squared.argmin())
         return int(candidates[j]), float(np.sqrt(squared[j]))
@@ -192,7 +210,8 @@ class NearestNeighbourMemory:
     def nbytes(self) -> int:
         """Bytes held by the preallocated arrays."""
         arrays = (self._rows, self._codes, self._block_squares, self._block_min, self._candidates)
-        return sum(a.nbytes for a in arrays)
+        trees = (self._squares, self._order, self._leaf_codes, self._boxes)
+        return sum(a.nbytes for a in arrays + trees)
 
     def _allocate(self, capacity: int) -> None:
         """Empty arrays for `capacity` rows (the first `self._n` are copied by the caller)."""
@@ -204,6 +223,15 @@ class NearestNeighbourMemory:
         self._block_squares = np.empty(BLOCK_ROWS, dtype=np.float32)  # the kernel's scratch
         self._block_min = np.empty(n_blocks + 1, dtype=np.float32)
         self._candidates = np.empty(capacity, dtype=np.intp)
+        self._squares = np.empty(capacity, dtype=np.float32)  # the candidates' b^2
+        # The trees (learner/code_tree.py), in arrays indexed by row, leaf and node: empty in
+        # a memory too small for trees.
+        trees = capacity >= 2 * self._tree_rows
+        n_leaves = capacity // LEAF_ROWS if trees else 0
+        self._order = np.empty(capacity if trees else 0, dtype=np.intp)
+        self._leaf_codes = np.empty((n_leaves, self._dim, LEAF_ROWS), dtype=np.int8)
+        if self._n == 0:  # (a memory that grows keeps its trees' boxes)
+            self._drop_trees()
 
     def _reserve(self, n_rows: int) -> None:
         """Make room for n_rows, doubling the capacity as often as needed."""
@@ -212,10 +240,12 @@ class NearestNeighbourMemory:
             return
         while capacity < n_rows:
             capacity *= 2
-        rows, codes = self._rows[: self._n], self._codes
+        old = self._rows[: self._n], self._codes, self._order, self._leaf_codes
         self._allocate(capacity)
-        self._rows[: self._n] = rows
-        self._codes[: len(codes)] = codes
+        for new, kept in zip(
+            (self._rows, self._codes, self._order, self._leaf_codes), old, strict=True
+        ):
+            new[: len(kept)] = kept
 
     def _code_from(self, start: int) -> None:
         """Write the codes of the rows from `start` on; a value beyond the grid widens it and
@@ -224,9 +254,65 @@ class NearestNeighbourMemory:
         if max_abs > self._scale:
             self._scale = _scale_for(max_abs)
             start = 0
+            self._drop_trees()  # the grid changed: rebuilt below, from the rows
         codes = np.rint(self._rows[start : self._n].T * (CODE_MAX / self._scale))
         for b in range(start // BLOCK_ROWS, -(-self._n // BLOCK_ROWS)):  # the blocks written
             first, end = max(start, b * BLOCK_ROWS), min(self._n, (b + 1) * BLOCK_ROWS)
             self._codes[b, :, first - b * BLOCK_ROWS : end - b * BLOCK_ROWS] = codes[
                 :, first - start : end - start
             ]
+        if self._n >= self._next_trees:
+            self._grow_trees()
+
+    def _drop_trees(self) -> None:
+        self._runs: list[tuple[int, int]] = []  # each tree's first row and rows
+        self._tree_levels: list[list[int]] = []  # each tree's levels' first blocks in _boxes
+        self._boxes = np.empty((0, 2, self._dim, FANOUT), dtype=np.float32)
+        self._tail = 0  # the first row no tree holds
+        self._next_trees = 2 * self._tree_rows  # rows at which the trees grow next
+        self._table_trees()
+
+    def _grow_trees(self) -> None:
+        """Trees over every whole `tree_rows` of rows, as a binary counter counts them: runs of
+        tree_rows times the powers of two of that count, largest (oldest rows) first. Two
+        trees of one size become one of twice the size, so a row is sorted into a tree about
+        log2(n / tree_rows) times over the memory's life and a query searches as many trees.
+        Trees whose rows do not change are kept."""
+        chunks = self._n // self._tree_rows
+        wanted, first = [], 0
+        for bit in range(chunks.bit_length() - 1, -1, -1):
+            if chunks >> bit & 1:
+                wanted.append((first, self._tree_rows << bit))
+                first += self._tree_rows << bit
+        kept = 0
+        while kept < min(len(wanted), len(self._runs)) and self._runs[kept] == wanted[kept]:
+            kept += 1
+        levels = self._tree_levels[:kept]
+        end = levels[-1][-1] if levels else 0  # blocks of boxes the kept trees use
+        for _, size in wanted[kept:]:
+            levels.append([end + start for start in tree_levels(size // LEAF_ROWS)])
+            end = levels[-1][-1]
+        if end > len(self._boxes):  # room for the new trees' boxes, the kept ones copied
+            boxes = np.empty((2 * end, 2, self._dim, FANOUT), dtype=np.float32)
+            boxes[: len(self._boxes)] = self._boxes
+            self._boxes = boxes
+        for k in range(kept, len(wanted)):
+            first, size = wanted[k]
+            arrays = (self._order, self._leaf_codes, self._boxes, np.array(levels[k]))
+            build_tree(self._rows, self._codes, first, size, *arrays)
+        self._runs, self._tree_levels = wanted, levels
+        self._tail = first  # the first row no tree holds
+        self._next_trees = first + self._tree_rows
+        self._table_trees()
+
+    def _table_trees(self) -> None:
+        """The trees as the screen's kernel reads them: (first row, levels' count) each, and
+        their levels' first blocks, a row each."""
+        width = max((len(levels) for levels in self._tree_levels), default=1)
+        table = [
+            (first, len(levels))
+            for (first, _), levels in zip(self._runs, self._tree_levels, strict=True)
+        ]
+        self._tree_table = np.array(table, dtype=np.int64).reshape(-1, 2)
+        padded = [levels + [0] * (width - len(levels)) for levels in self._tree_levels]
+        self._levels = np.array(padded, dtype=np.int64).reshape(-1, width)

@@ -61,7 +61,16 @@ def candidate_limit(dim: int, query_code_norm: float) -> tuple[float, float]:
 
 
 @_compiled
-def _block_squares(
+def screening_limit(nearest_bound: float, eta: float, rho: float) -> np.float32:
+    """The largest b^2 a candidate can have when the nearest row lies at most `nearest_bound`
+    from the query (in the screened values' units): the bound of `candidate_limit`, squared,
+    the float32 limit rounded up, never down."""
+    bound = (nearest_bound + eta) * (1.0 + rho)
+    return np.float32(bound * bound * (1.0 + 1e-6))
+
+
+@_compiled
+def squares_of_block(
     codes: np.ndarray, b: int, size: int, query: np.ndarray, out: np.ndarray
 ) -> None:
     """b_i^2 of the first `size` rows of block b into out[:size] (see the module docstring)."""
@@ -79,7 +88,7 @@ def _block_squares(
 
 
 @_compiled
-def _minimum(values: np.ndarray, size: int, lanes: np.ndarray) -> np.float32:
+def smallest(values: np.ndarray, size: int, lanes: np.ndarray) -> np.float32:
     """The smallest of values[:size], as 16 partial minima the compiler keeps in one vector
     register (a plain running minimum of floats is not vectorised)."""
     for j in range(_LANES):
@@ -114,23 +123,51 @@ def screen_candidates(
     i % BLOCK_ROWS]); query (dim,) float32 in code units; block_squares (>= BLOCK_ROWS,) and
     block_min (>= n / BLOCK_ROWS + 1,) float32 scratch; candidates (>= n,).
     """
-    n_blocks = (n + BLOCK_ROWS - 1) // BLOCK_ROWS
+    best = block_minima(codes, 0, n, query, block_squares, block_min)
+    limit = screening_limit(math.sqrt(best) / (1.0 - rho) + eta, eta, rho)
+    return block_candidates(codes, 0, n, query, limit, block_squares, block_min, candidates, 0)
+
+
+@_compiled
+def block_minima(
+    codes: np.ndarray,
+    first: int,
+    n: int,
+    query: np.ndarray,
+    block_squares: np.ndarray,
+    block_min: np.ndarray,
+) -> np.float32:  # pragma: no cover - compiled
+    """The smallest b^2 of rows first..n-1 (first a multiple of BLOCK_ROWS), each block's
+    written into block_min (inf for none)."""
     lanes = np.empty(_LANES, np.float32)
     best = np.float32(np.inf)
-    for b in range(n_blocks):
+    for b in range(first // BLOCK_ROWS, (n + BLOCK_ROWS - 1) // BLOCK_ROWS):
         size = min(BLOCK_ROWS, n - b * BLOCK_ROWS)
-        _block_squares(codes, b, size, query, block_squares)
-        m = _minimum(block_squares, size, lanes)
+        squares_of_block(codes, b, size, query, block_squares)
+        m = smallest(block_squares, size, lanes)
         block_min[b] = m
         best = m if m < best else best
-    # candidate_limit's bound, squared; the float32 limit rounded up, never down.
-    bound = (math.sqrt(best) / (1.0 - rho) + 2.0 * eta) * (1.0 + rho)
-    limit = np.float32(bound * bound * (1.0 + 1e-6))
-    count = 0
-    for b in range(n_blocks):
+    return best
+
+
+@_compiled
+def block_candidates(
+    codes: np.ndarray,
+    first: int,
+    n: int,
+    query: np.ndarray,
+    limit: np.float32,
+    block_squares: np.ndarray,
+    block_min: np.ndarray,
+    candidates: np.ndarray,
+    count: int,
+) -> int:  # pragma: no cover - compiled
+    """After `block_minima`: the rows first..n-1 whose b^2 is at most `limit`, in increasing
+    order, written into candidates after the `count` there; returns the new count."""
+    for b in range(first // BLOCK_ROWS, (n + BLOCK_ROWS - 1) // BLOCK_ROWS):
         if block_min[b] <= limit:  # usually one block: its squares again, the same numbers
             size = min(BLOCK_ROWS, n - b * BLOCK_ROWS)
-            _block_squares(codes, b, size, query, block_squares)
+            squares_of_block(codes, b, size, query, block_squares)
             for i in range(size):
                 if block_squares[i] <= limit:
                     candidates[count] = b * BLOCK_ROWS + i
