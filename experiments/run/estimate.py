@@ -4,19 +4,21 @@ The disk a trial holds at its end grows with its iterations: a row of logs each,
 learner's memory, each row of it written once, in the segment of the checkpoint period that
 stored it (experiments/run/memory_segments.py), beside two checkpoints of a fixed size. The
 bytes it writes grow as the disk does, in proportion to the iterations (before segments, every
-checkpoint rewrote every row: they grew with the square). Its time grows faster, with the
-square of the iterations: the memory's nearest-neighbour query scans one more row each
-iteration. So a trial ten times the study's length costs about a hundred times its time, and a
-billion iterations decades.
+checkpoint rewrote every row: they grew with the square). Its time per iteration grows with the
+learner's memory, less than in proportion to it since older rows are searched through trees
+(learner/code_tree.py): the growth measured by `playroom bench long` between iterations 80000
+and 10^6, a power of the iteration through those two figures, is the growth assumed at every
+length beyond 80000 (`growth_seconds`).
 
 The estimate rests on the costs measured on the development machine (docs/speed.md, its bench
 figures at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
-measured. Another machine scales the time, not the disk. A trial that will not fit on its disk
+measured; on 10^6 iterations 4.1 min, where 3 min 3 s were measured (`playroom bench long`). Another machine scales the time, not the disk. A trial that will not fit on its disk
 is refused before anything is written, `--quiet` or not (`check_fits`).
 """
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 from dataclasses import dataclass
@@ -35,9 +37,11 @@ from experiments.run.trial_files import TrialError
 # Seconds of an iteration, by grasp backend: 5293 and 559 iterations a second over trials of
 # 5000 iterations (docs/speed.md, `playroom bench trial`).
 SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
-# The inverse query scans the chosen model's rows, at most one per iteration so far: 77 us at
-# 80000 rows (docs/speed.md, `playroom bench learner`), in proportion to them.
-QUERY_SECONDS_PER_ROW = 77e-6 / 80000
+# A kinematic trial's seconds per iteration near iteration 80000 and near 10^6, measured by
+# `playroom bench long` at commit 3ffbbe4 (docs/speed.md): how the learner's cost grows.
+GROWTH_FROM = 80000
+SECONDS_NEAR_GROWTH_FROM = 0.1308e-3
+SECONDS_NEAR_A_MILLION = 0.2219e-3
 # Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to
 # the memory's segments (585 measured over iterations 1000 to 20000 of a kinematic trial, seed 0,
 # none during the study's bootstrap; 611 in issue 31's checkpoints, 416 MB at 681000: rounded up
@@ -65,14 +69,14 @@ class TrialCosts:
 def trial_costs(settings: TrialSettings, start: int = 0) -> TrialCosts:
     """The costs of running `settings`' trial from iteration `start` to its end."""
     n, s = settings.iterations, min(start, settings.iterations)
-    # The rows scanned over iterations s..n-1, about sum(i) = (n^2 - s^2) / 2. Each iteration's
-    # rows are written once; a checkpoint every `checkpoint_every`, and one at the end.
-    rows = (n * n - s * s) / 2
+    # Each iteration's rows are written once; a checkpoint every `checkpoint_every`, and one at
+    # the end.
     checkpoints = -(-(n - s) // settings.checkpoint_every)
     written = MEMORY_BYTES_PER_ITERATION * (n - s) + CHECKPOINT_BYTES * checkpoints
     seconds = (
         (n - s) * _per_iteration(settings.grasp)
-        + rows * QUERY_SECONDS_PER_ROW
+        + growth_seconds(n)
+        - growth_seconds(s)
         + written / CHECKPOINT_BYTES_PER_SECOND
     )
     disk = n * (LOG_BYTES_PER_ITERATION + MEMORY_BYTES_PER_ITERATION) + 2 * CHECKPOINT_BYTES
@@ -90,7 +94,8 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
     basis = (
         f"estimated from the development machine's costs: "
         f"{1000 * _per_iteration(settings.grasp):.2g} ms an iteration, "
-        f"plus {1e9 * QUERY_SECONDS_PER_ROW:.2g} ns per row of memory searched, "
+        f"plus the learner's growth beyond {GROWTH_FROM}: x{_GROWTH_RATIO:.2g} an iteration at "
+        f"10^6, as `playroom bench long` measured, "
         f"{LOG_BYTES_PER_ITERATION} B of logs and {MEMORY_BYTES_PER_ITERATION} B of memory an "
         f"iteration, {size(CHECKPOINT_BYTES)} a checkpoint"
     )
@@ -107,6 +112,21 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
         f"checkpoints on {out_dir} ({free_text} free); its checkpoints, each writing the "
         f"memory's new rows, write ~{size(costs.written_bytes)} in all ({basis})"
     )
+
+
+_GROWTH_RATIO = SECONDS_NEAR_A_MILLION / SECONDS_NEAR_GROWTH_FROM
+# The power of the iteration the measured cost per iteration follows between the two figures.
+_GROWTH_POWER = math.log(_GROWTH_RATIO) / math.log(1e6 / GROWTH_FROM)
+
+
+def growth_seconds(iterations: int) -> float:
+    """Seconds the learner's growth adds over a trial's first `iterations`, above its cost
+    near GROWTH_FROM: the integral of c (i / GROWTH_FROM)^p - c from GROWTH_FROM on, c and p
+    through the two measured figures."""
+    if iterations <= GROWTH_FROM:
+        return 0.0
+    x, p = iterations / GROWTH_FROM, _GROWTH_POWER
+    return SECONDS_NEAR_GROWTH_FROM * GROWTH_FROM * ((x ** (p + 1) - 1) / (p + 1) - (x - 1))
 
 
 def _per_iteration(grasp: str) -> float:

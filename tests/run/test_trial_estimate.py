@@ -22,19 +22,29 @@ def _free(monkeypatch, free: int) -> None:
     monkeypatch.setattr(shutil, "disk_usage", lambda path: Usage(10**15, 10**15 - free, free))
 
 
-def test_disk_and_checkpoint_writes_grow_with_the_iterations_time_with_their_square():
+def test_disk_and_checkpoint_writes_grow_with_the_iterations_time_faster():
     one = estimate.trial_costs(TrialSettings(iterations=100000, checkpoint_every=1000))
     two = estimate.trial_costs(TrialSettings(iterations=200000, checkpoint_every=1000))
     assert two.disk_bytes == pytest.approx(2 * one.disk_bytes, rel=0.01)
     # Each row of memory is written once (experiments/run/memory_segments.py), not by every
     # checkpoint again (issue 34).
     assert two.written_bytes == pytest.approx(2 * one.written_bytes, rel=0.01)
-    assert two.seconds > 2 * one.seconds  # the query scans more rows as the memory grows
+    assert two.seconds > 2 * one.seconds  # the query searches more rows as the memory grows
     slower = estimate.trial_costs(TrialSettings(grasp="physical", iterations=100000))
     assert slower.seconds > one.seconds and slower.disk_bytes == one.disk_bytes
     # A resumed trial costs what is left to run: nothing once it is finished.
     done = estimate.trial_costs(TrialSettings(iterations=100000), start=100000)
     assert done.seconds == 0 and done.written_bytes == 0
+
+
+def test_the_estimated_growth_passes_through_the_measured_costs():
+    """The learner's growth assumed by the estimate is the one `playroom bench long` measured:
+    an iteration near 10^6 costs what it measured there, over one near 80000."""
+    step = 1000
+    near_a_million = estimate.growth_seconds(10**6) - estimate.growth_seconds(10**6 - step)
+    per_iteration = estimate.SECONDS_NEAR_GROWTH_FROM + near_a_million / step
+    assert per_iteration == pytest.approx(estimate.SECONDS_NEAR_A_MILLION, rel=0.01)
+    assert estimate.growth_seconds(estimate.GROWTH_FROM) == 0.0
 
 
 def test_a_trial_that_does_not_fit_on_its_disk_is_refused_before_anything_is_written(
