@@ -141,9 +141,13 @@ class NearestNeighbourMemory:
         self._code_from(n)
 
     def trees(self) -> list[tuple[int, int]]:
-        """The trees' runs of rows (first row, rows), oldest first (learner/code_tree.py); the
-        rows after the last are screened block by block."""
+        """The trees' runs of rows (first row, rows), oldest first (learner/code_tree.py)."""
         return list(self._runs)
+
+    @property
+    def rows_past_trees(self) -> int:
+        """The newest rows, which no tree holds: a query screens them block by block."""
+        return self._n - self._tail
 
     def nearest(self, query: ArrayLike) -> tuple[int, float]:
         """(index of the nearest row, Euclidean distance), as `brute_force_nearest` answers.
@@ -297,11 +301,10 @@ class NearestNeighbourMemory:
             boxes[: len(self._boxes)] = self._boxes
             self._boxes = boxes
         for k in range(kept, len(wanted)):
-            first, size = wanted[k]
             arrays = (self._order, self._leaf_codes, self._boxes, np.array(levels[k]))
-            build_tree(self._rows, self._codes, first, size, *arrays)
+            build_tree(self._rows, self._codes, *wanted[k], *arrays)
         self._runs, self._tree_levels = wanted, levels
-        self._tail = first  # the first row no tree holds
+        self._tail = first  # the first row no tree holds: where the loop above left it
         self._next_trees = first + self._tree_rows
         self._table_trees()
 

@@ -54,8 +54,13 @@ def test_trees_answer_as_brute_force_as_they_grow_and_merge(shape: str) -> None:
         memory.append(row)
         if n in checked:
             _assert_brute_force(memory, rows[:n], _queries(rng, rows[:n]))
+        if n >= 2 * SMALL_TREES:  # every row but the newest in a tree, each in one
+            runs = memory.trees()
+            assert [first for first, _ in runs] == list(np.cumsum([0] + [s for _, s in runs])[:-1])
+            assert n - sum(size for _, size in runs) == memory.rows_past_trees < SMALL_TREES
     # Seven whole runs of 1024 as a binary counter counts them: 4096 + 2048 + 1024.
     assert memory.trees() == [(0, 4096), (4096, 2048), (6144, 1024)]
+    assert memory.rows_past_trees == 7300 - 7168
 
 
 def test_a_memory_below_two_trees_is_screened_as_before() -> None:
