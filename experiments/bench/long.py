@@ -1,8 +1,10 @@
 """`playroom bench long`: the cost of development longer than the study's, measured on one
 trial of 10^6 iterations (issue 34): its cost per iteration and the bytes a checkpoint writes
 near 80000 iterations and near its end, from the memory segments it writes every 1000
-iterations (their write times and sizes), and its peak memory. One trial in a process of its
-own, run as `playroom run` runs it (study preset, kinematic, seed 0), in a temporary directory.
+iterations (their write times and sizes), and its peak memory; then each model's inverse query
+on its final memories, scanned whole and through the nearest-neighbour index. One trial in a
+process of its own, run as `playroom run` runs it (study preset, kinematic, seed 0), in a
+temporary directory.
 
 Why from the segments: a trial writes one per checkpoint period, so their times are the
 trial's own clock at every 1000 iterations, with nothing added to the trial to measure it.
@@ -14,10 +16,17 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
+
 from experiments.file_names import CHECKPOINT_FILE, MEMORY_DIR
+from experiments.run.memory_segments import AGENT, read_checkpoint
+from learner.memory import TREE_ROWS, NearestNeighbourMemory
+from learner.sensorimotor_model import MODELS
+from models.layout import BLOCK_DIM
 
 LONG_ITERATIONS = 1_000_000
 NEAR = 80_000  # the study's length: the reference point
@@ -27,6 +36,7 @@ PERIOD = 1_000  # the trial's checkpoint period: one segment each
 COST_RATIO_TARGET = 2.0
 BYTES_RATIO_TARGET = 1.5
 PEAK_MEMORY_TARGET_MB = 4096
+_NO_TREES = 2**62  # a memory that never sorts its rows into trees: the whole scan
 # The child prints its own peak resident memory after the trial (kB on Linux).
 _CHILD = (
     "import resource, sys; from experiments.cli.main import main; rc = main(sys.argv[1:]); "
@@ -52,6 +62,7 @@ def long_figures(
         late = iterations - PERIOD - window  # the last segment is the last period's
         early_cost, late_cost = (_cost(out, start, window) for start in (near, late))
         early_bytes, late_bytes = (_checkpoint_bytes(out, start) for start in (near, late))
+        queries = list(query_figures(out))
     yield f"long_cost_per_iteration_near_{near}", early_cost * 1e3, "ms"
     yield f"long_cost_per_iteration_near_{iterations}", late_cost * 1e3, "ms"
     ratio = late_cost / early_cost
@@ -61,6 +72,47 @@ def long_figures(
     bytes_ratio = late_bytes / early_bytes
     yield "long_checkpoint_bytes_ratio", bytes_ratio, f"ratio (target <= {BYTES_RATIO_TARGET:g})"
     yield "long_peak_memory", peak_kb / 1024, f"MB (target < {PEAK_MEMORY_TARGET_MB})"
+    yield from queries
+
+
+def query_figures(
+    trial: Path, n_queries: int = 300, passes: int = 3
+) -> Iterator[tuple[str, float, str]]:
+    """Each model's inverse query on the trial's final memories, scanned whole and through the
+    trees (learner/code_tree.py), the same answers asserted: microseconds a query, the best
+    of `passes` over `n_queries` goals (uniform in [-1, 1]^10, with a stored row's context),
+    and their mean over the models that hold rows (random babbling's choice)."""
+    arrays, _ = read_checkpoint(trial / CHECKPOINT_FILE)
+    rng = np.random.default_rng(0)
+    keys = {s.number: arrays[f"{AGENT}model{s.number}.key"] for s in MODELS}
+    held = [spec for spec in MODELS if len(keys[spec.number])]
+    means = {"scan": 0.0, "trees": 0.0}
+    for spec in held:
+        rows = keys[spec.number]
+        context = rows[rng.integers(0, len(rows), n_queries), : len(spec.context_dims)]
+        queries = np.hstack((context, rng.uniform(-1.0, 1.0, (n_queries, BLOCK_DIM))))
+        answers, seconds = {}, {}
+        for name, tree_rows in (("scan", _NO_TREES), ("trees", TREE_ROWS)):
+            memory = NearestNeighbourMemory(rows.shape[1], tree_rows=tree_rows)
+            memory.extend(rows)
+            answers[name] = [memory.nearest_index(q) for q in queries]
+            seconds[name] = min(_time_queries(memory, queries) for _ in range(passes))
+            means[name] += seconds[name] / len(held)
+        if answers["scan"] != answers["trees"]:
+            raise AssertionError(f"model {spec.number}: the trees answered otherwise")
+        for name in ("scan", "trees"):
+            unit = f"us ({len(rows)} rows of {rows.shape[1]})"
+            yield f"long_query_model{spec.number}_{name}", 1e6 * seconds[name], unit
+    for name in ("scan", "trees"):
+        yield f"long_query_mean_{name}", 1e6 * means[name], "us"
+
+
+def _time_queries(memory: NearestNeighbourMemory, queries: np.ndarray) -> float:
+    """Seconds a query, over `queries` one after the other."""
+    start = time.perf_counter()
+    for q in queries:
+        memory.nearest_index(q)
+    return (time.perf_counter() - start) / len(queries)
 
 
 def _segment(trial: Path, start: int) -> Path:

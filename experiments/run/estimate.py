@@ -38,10 +38,10 @@ from experiments.run.trial_files import TrialError
 # 5000 iterations (docs/speed.md, `playroom bench trial`).
 SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
 # A kinematic trial's seconds per iteration near iteration 80000 and near 10^6, measured by
-# `playroom bench long` at commit 3ffbbe4 (docs/speed.md): how the learner's cost grows.
+# `playroom bench long` at commit eebcc93 (docs/speed.md): how the learner's cost grows.
 GROWTH_FROM = 80000
-SECONDS_NEAR_GROWTH_FROM = 0.1308e-3
-SECONDS_NEAR_A_MILLION = 0.2219e-3
+SECONDS_NEAR_GROWTH_FROM = 0.1327e-3
+SECONDS_NEAR_A_MILLION = 0.2331e-3
 # Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to
 # the memory's segments (585 measured over iterations 1000 to 20000 of a kinematic trial, seed 0,
 # none during the study's bootstrap; 611 in issue 31's checkpoints, 416 MB at 681000: rounded up
