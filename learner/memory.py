@@ -1,11 +1,13 @@
 """Exact Euclidean nearest-neighbour memory of rows that grow one at a time.
 
-Why not a k-d tree: the agent's hot query is the inverse model's, with a goal drawn uniformly in
-[-1, 1]^10, far from the data, in 10 to 38 dimensions. A k-d tree must then open most of its
-leaves: scipy's cKDTree measured 0.2 to 2.8 times the time of a plain NumPy scan at 80000 rows.
+Why not a plain k-d tree: the agent's hot query is the inverse model's, with a goal drawn
+uniformly in [-1, 1]^10, far from the data, in 10 to 38 dimensions. A k-d tree must then open
+most of its leaves: scipy's cKDTree measured 0.2 to 2.8 times the time of a plain NumPy scan at
+80000 rows.
 
 What this memory does instead is a scan made cheap, in two stages, with the same answer as
-`brute_force_nearest` (including which row wins a tie: the lowest index):
+`brute_force_nearest` (including which row wins a tie: the lowest index), and, for memories
+longer than a study-length trial's, trees made for that scan (3.):
 
 1. Screening (learner/quantized_scan.py): every row is also kept as 8-bit codes on a grid of
    step `scale / 127`; a compiled kernel computes the query's distance to every row's codes in
@@ -13,6 +15,11 @@ What this memory does instead is a scan made cheap, in two stages, with the same
    to be the nearest. Usually that is one row.
 2. Exact re-ranking, float64: the candidates are re-ranked with the very expression of the
    brute-force reference.
+3. Long development (learner/code_tree.py, learner/indexed_screen.py): from 2 x TREE_ROWS rows
+   on, the older rows are also sorted into static k-d trees over runs of TREE_ROWS x 2^k rows,
+   merged as a binary counter counts, and a query screens only the newest rows block by
+   block and the trees' leaves whose boxes can hold a candidate. The candidates still hold
+   every row at the nearest distance, so stage 2 gives the same answer.
 
 The grid's `scale` is the smallest power of two, at least 1, above every stored |value|: the
 agent's spaces lie in [-1, 1], so it is 1; a larger value re-codes every row (rarely: at most
@@ -179,8 +186,14 @@ class NearestNeighbourMemory:
         """(index of the nearest row, its distance, or None where a single candidate made
         computing it unnecessary) for a checked query."""
         n = self._n
-        trees = (self._tail, self._tree_table, self._levels, self._order, self._leaf_codes)
-        trees += (self._boxes,)
+        trees = (
+            self._tail,
+            self._tree_table,
+            self._levels,
+            self._order,
+            self._leaf_codes,
+            self._boxes,
+        )
         scratch = (self._block_squares, self._block_min, self._candidates, self._squares)
         count = screen_query(self._codes, self._rows, n, q, self._scale, trees, scratch)
         if count < 0:  # far outside the grid: scanned exactly
@@ -244,11 +257,10 @@ class NearestNeighbourMemory:
             return
         while capacity < n_rows:
             capacity *= 2
-        old = self._rows[: self._n], self._codes, self._order, self._leaf_codes
+        old: list[np.ndarray] = [self._rows[: self._n], self._codes, self._order, self._leaf_codes]
         self._allocate(capacity)
-        for new, kept in zip(
-            (self._rows, self._codes, self._order, self._leaf_codes), old, strict=True
-        ):
+        grown: list[np.ndarray] = [self._rows, self._codes, self._order, self._leaf_codes]
+        for new, kept in zip(grown, old, strict=True):
             new[: len(kept)] = kept
 
     def _code_from(self, start: int) -> None:

@@ -12,6 +12,9 @@ rounded to float32, the kernel computes b_i^2 = sum_d (c_id - q'_d)^2 in float32
 rows that stay in the L1 cache, and keeps the smallest value of every block. It then returns
 every row whose b_i can belong to the exact nearest row, by the bound of `candidate_limit`.
 
+A memory of more rows than a study-length trial's screens only its newest rows this way and its
+older ones through trees whose leaves are laid out as these blocks (learner/code_tree.py).
+
 Codes are stored block by block, (blocks, dim, BLOCK_ROWS): a block's codes are one contiguous
 run of memory, so a scan is a single sequential stream the hardware prefetcher follows. (With
 one row of codes per dimension the scan read `dim` interleaved streams: measured 25% slower

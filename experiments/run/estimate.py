@@ -11,8 +11,10 @@ and 10^6, a power of the iteration through those two figures, is the growth assu
 length beyond 80000 (`growth_seconds`).
 
 The estimate rests on the costs measured on the development machine (docs/speed.md, its bench
-figures at commit 1a4591c); on the study's 80000-iteration trial it says 19 s, where 17.1 s were
-measured; on 10^6 iterations 4.1 min, where 3 min 3 s were measured (`playroom bench long`). Another machine scales the time, not the disk. A trial that will not fit on its disk
+figures at commit 1a4591c, and `playroom bench long` at eebcc93); on the study's 80000-iteration
+trial it says 15 s, where 17.1 s were measured at 1a4591c and 9.5 s on 2026-11-25; on 10^6
+iterations 4.2 min, where 3 min 25 s were measured (beside a second trial). Another machine
+scales the time, not the disk. A trial that will not fit on its disk
 is refused before anything is written, `--quiet` or not (`check_fits`).
 """
 
