@@ -16,9 +16,18 @@ import math
 
 import numpy as np
 
-from learner.code_tree import EXACT_MARGIN, distance, search_tree
+from learner.code_tree import (
+    EXACT_MARGIN,
+    FANOUT,
+    LEAF_ROWS,
+    build_tree,
+    distance,
+    search_tree,
+    tree_levels,
+)
 from learner.compiled import compiled
 from learner.quantized_scan import (
+    BLOCK_ROWS,
     CODE_MAX,
     FAR_QUERY_CODES,
     block_candidates,
@@ -26,6 +35,7 @@ from learner.quantized_scan import (
     candidate_limit,
     screen_candidates,
     screening_limit,
+    store_row,
 )
 
 
@@ -91,3 +101,22 @@ def screen_query(
     return block_candidates(
         codes, tail, n, query, limit, block_squares, block_min, candidates, count
     )
+
+
+def warm_up() -> None:
+    """Load (or, on a first run, compile and cache) the memory's kernels now rather than at the
+    first store, query and tree: once per process, 0.2 s from numba's cache, a few seconds to
+    compile."""
+    dim, rows = 1, BLOCK_ROWS  # one tree of a whole block: no row past it
+    codes = np.zeros((1, dim, BLOCK_ROWS), dtype=np.int8)
+    values = np.zeros((rows, dim))
+    store_row(values, codes, 0, np.zeros(dim), 1.0)
+    order = np.empty(rows, np.intp)
+    leaf_codes = np.empty((rows // LEAF_ROWS, dim, LEAF_ROWS), np.int8)
+    levels = np.array(tree_levels(rows // LEAF_ROWS), dtype=np.int64)
+    boxes = np.empty((levels[-1], 2, dim, FANOUT), np.float32)
+    build_tree(values, codes, 0, rows, order, leaf_codes, boxes, levels)
+    trees = (rows, np.array([[0, len(levels)]]), levels[None, :], order, leaf_codes, boxes)
+    squares = np.empty(BLOCK_ROWS, np.float32)
+    scratch = (squares, squares[:2].copy(), np.empty(rows, np.intp), np.empty(rows, np.float32))
+    screen_query(codes, values, rows, np.zeros(dim), 1.0, trees, scratch)

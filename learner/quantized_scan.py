@@ -178,34 +178,6 @@ def block_candidates(
     return count
 
 
-@_compiled
-def screen_query(
-    codes: np.ndarray,
-    n: int,
-    q: np.ndarray,
-    code_scale: float,
-    block_squares: np.ndarray,
-    block_min: np.ndarray,
-    candidates: np.ndarray,
-) -> int:  # pragma: no cover - compiled; its answers are tested against brute force
-    """`screen_candidates` for a float64 query q (dim,) in the rows' units: its codes (q times
-    code_scale, rounded to float32) and the bound made here rather than in NumPy calls around
-    the kernel. Returns the candidates' count, or -1 for a query too far outside the grid for
-    float32 sums (FAR_QUERY_CODES), which the caller scans exactly."""
-    dim = q.shape[0]
-    query = np.empty(dim, np.float32)
-    largest, norm2 = 0.0, 0.0
-    for d in range(dim):
-        v = q[d] * code_scale
-        largest = max(largest, abs(v))
-        norm2 += v * v
-        query[d] = np.float32(v)
-    if not largest < FAR_QUERY_CODES:
-        return -1
-    eta, rho = candidate_limit(dim, math.sqrt(norm2))
-    return screen_candidates(codes, n, query, eta, rho, block_squares, block_min, candidates)
-
-
 @compiled  # no fused operations: the codes are NumPy's rint of the same product
 def store_row(rows: np.ndarray, codes: np.ndarray, n: int, row: np.ndarray, scale: float) -> bool:
     """Write `row` (dim,) as row n of `rows` (capacity, dim) and, if no |value| exceeds the
@@ -223,12 +195,3 @@ def store_row(rows: np.ndarray, codes: np.ndarray, n: int, row: np.ndarray, scal
     for d in range(row.shape[0]):
         codes[block, d, i] = np.int8(np.rint(rows[n, d] * factor))
     return True
-
-
-def warm_up() -> None:
-    """Load (or, on a first run, compile and cache) the memory's kernels now rather than at the
-    first store and query: once per process, 0.2 s from numba's cache, about 1 s to compile."""
-    codes = np.zeros((1, 1, BLOCK_ROWS), dtype=np.int8)
-    store_row(np.empty((1, 1)), codes, 0, np.zeros(1), 1.0)
-    scratch = np.empty(BLOCK_ROWS, dtype=np.float32)
-    screen_query(codes, 1, np.zeros(1), 1.0, scratch, scratch[:2].copy(), np.empty(1, np.intp))

@@ -187,7 +187,7 @@ def trial_figures(iterations: int = 5000) -> Iterator[tuple[str, float, str]]:
     model (the fastest of TRIAL_RUNS runs of each, in turns); the replication's own trial,
     measured whole; the profiles' times from them."""
     from experiments.batches.spec import load_spec
-    from learner.quantized_scan import warm_up
+    from learner.indexed_screen import warm_up
 
     # The memory's compiled kernel loads once per process (a batch worker runs many trials):
     # timed on its own, so the trials below measure iterations alone.

@@ -54,7 +54,7 @@ def replication_pair_seconds(
 
 
 def _warm_replication_trial(settings: TrialSettings, placements: int) -> tuple[float, float]:
-    from learner.quantized_scan import warm_up
+    from learner.indexed_screen import warm_up
 
     warm_up()  # once per worker process, as in a batch: not a trial's time
     return replication_trial_seconds(settings, placements)

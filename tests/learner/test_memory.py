@@ -127,15 +127,19 @@ def test_memory_rejects_bad_input() -> None:
 def test_warm_up_loads_the_kernel_the_memory_uses() -> None:
     """`playroom bench` times the kernel's load apart from the trials: that holds only if the
     warm-up compiles the very specialisations a memory's store and query call."""
-    from learner.quantized_scan import screen_query, store_row, warm_up
+    from learner.code_tree import build_tree
+    from learner.indexed_screen import screen_query, warm_up
+    from learner.quantized_scan import store_row
 
+    kernels = (screen_query, store_row, build_tree)
     warm_up()
-    loaded = set(screen_query.signatures), set(store_row.signatures)
-    memory = NearestNeighbourMemory(14)
-    memory.extend(np.random.default_rng(5).uniform(-1, 1, (100, 14)))
+    loaded = [set(kernel.signatures) for kernel in kernels]
+    memory = NearestNeighbourMemory(14, tree_rows=1024)  # trees from 2048 rows on
+    memory.extend(np.random.default_rng(5).uniform(-1, 1, (3000, 14)))
     memory.append(np.full(14, 0.5), checked=True)
     memory.nearest(np.zeros(14))
-    assert (set(screen_query.signatures), set(store_row.signatures)) == loaded
+    assert memory.trees()
+    assert [set(kernel.signatures) for kernel in kernels] == loaded
 
 
 def test_memory_works_where_numba_cannot_cache(run_without_numba_cache) -> None:
