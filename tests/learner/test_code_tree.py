@@ -115,3 +115,16 @@ def test_a_query_far_outside_the_grid_is_scanned_exactly_with_trees() -> None:
 def test_tree_rows_must_be_a_power_of_two_of_whole_blocks(tree_rows: int) -> None:
     with pytest.raises(ValueError, match="tree_rows must be a power of two"):
         NearestNeighbourMemory(10, tree_rows=tree_rows)
+
+
+def test_a_memory_of_the_default_tree_size_answers_as_brute_force() -> None:
+    """At the default sizes a long trial's memories reach: trees of 131072 and 65536 rows and
+    the newest rows past them, grown one row at a time."""
+    rng = np.random.default_rng(7)
+    rows = _arm_like_rows(rng, 3 * TREE_ROWS + 3000)
+    memory = NearestNeighbourMemory(10)
+    for row in rows:
+        memory.append(row, checked=True)
+    assert memory.trees() == [(0, 2 * TREE_ROWS), (2 * TREE_ROWS, TREE_ROWS)]
+    assert memory.rows_past_trees == 3000
+    _assert_brute_force(memory, rows, _queries(rng, rows, k=8))
