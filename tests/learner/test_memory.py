@@ -156,3 +156,31 @@ def test_memory_works_where_numba_cannot_cache(run_without_numba_cache) -> None:
         "print('exact')\n"
     )
     assert run_without_numba_cache(code) == "exact"
+
+
+def test_the_cached_kernels_are_dropped_when_any_learner_source_changes(tmp_path) -> None:
+    """numba checks a cached kernel against its own file only; a kernel calling another file's
+    would keep a stale copy of it. Any change of the package's sources drops every cached
+    kernel of it, once."""
+    from learner.compiled import forget_stale_kernels
+
+    package = tmp_path / "package"
+    (package / "__pycache__").mkdir(parents=True)
+    (package / "screen.py").write_text("calls = 'the tree search'\n")
+    (package / "tree.py").write_text("LEAF_ROWS = 64\n")
+    kernels = [package / "__pycache__" / f"screen.query-12.py311.{ext}" for ext in ("nbi", "nbc")]
+
+    def cache_kernels() -> None:
+        for kernel in kernels:
+            kernel.write_bytes(b"compiled")
+
+    assert forget_stale_kernels(package)  # no stamp yet: whatever is cached is of unknown code
+    cache_kernels()
+    assert not forget_stale_kernels(package)
+    assert all(kernel.exists() for kernel in kernels)
+    (package / "tree.py").write_text("LEAF_ROWS = 128\n")  # another file than the kernel's
+    assert forget_stale_kernels(package)
+    assert not any(kernel.exists() for kernel in kernels)
+    cache_kernels()
+    assert not forget_stale_kernels(package)
+    assert all(kernel.exists() for kernel in kernels)
