@@ -25,7 +25,7 @@ import numpy as np
 from experiments.file_names import CHECKPOINT_FILE, MEMORY_DIR
 from experiments.run.memory_segments import AGENT, read_checkpoint
 from learner.memory import TREE_ROWS, NearestNeighbourMemory
-from learner.sensorimotor_model import MODELS
+from learner.sensorimotor_model import MODELS, ModelSpec
 from models.layout import BLOCK_DIM
 
 LONG_ITERATIONS = 1_000_000
@@ -81,7 +81,9 @@ def query_figures(
     """Each model's inverse query on the trial's final memories, scanned whole and through the
     trees (learner/code_tree.py), the same answers asserted: microseconds a query, the best
     of `passes` over `n_queries` goals (uniform in [-1, 1]^10, with a stored row's context),
-    and their mean over the models that hold rows (random babbling's choice)."""
+    and their mean over the models that hold rows (random babbling's choice). Then how the
+    query grows: each model of at least 4 x TREE_ROWS rows, on its first 2 x TREE_ROWS x 2^k
+    rows, as it was when it held them."""
     arrays, _ = read_checkpoint(trial / CHECKPOINT_FILE)
     rng = np.random.default_rng(0)
     keys = {s.number: arrays[f"{AGENT}model{s.number}.key"] for s in MODELS}
@@ -89,22 +91,39 @@ def query_figures(
     means = {"scan": 0.0, "trees": 0.0}
     for spec in held:
         rows = keys[spec.number]
-        context = rows[rng.integers(0, len(rows), n_queries), : len(spec.context_dims)]
-        queries = np.hstack((context, rng.uniform(-1.0, 1.0, (n_queries, BLOCK_DIM))))
-        answers, seconds = {}, {}
-        for name, tree_rows in (("scan", _NO_TREES), ("trees", TREE_ROWS)):
-            memory = NearestNeighbourMemory(rows.shape[1], tree_rows=tree_rows)
-            memory.extend(rows)
-            answers[name] = [memory.nearest_index(q) for q in queries]
-            seconds[name] = min(_time_queries(memory, queries) for _ in range(passes))
-            means[name] += seconds[name] / len(held)
-        if answers["scan"] != answers["trees"]:
-            raise AssertionError(f"model {spec.number}: the trees answered otherwise")
+        seconds = _query_seconds(spec, rows, rng, n_queries, passes)
         for name in ("scan", "trees"):
+            means[name] += seconds[name] / len(held)
             unit = f"us ({len(rows)} rows of {rows.shape[1]})"
             yield f"long_query_model{spec.number}_{name}", 1e6 * seconds[name], unit
     for name in ("scan", "trees"):
         yield f"long_query_mean_{name}", 1e6 * means[name], "us"
+    for spec in held:
+        rows = keys[spec.number]
+        n = 2 * TREE_ROWS
+        while len(rows) >= 4 * TREE_ROWS and n < len(rows):
+            seconds = _query_seconds(spec, rows[:n], rng, n_queries, passes)
+            for name in ("scan", "trees"):
+                yield f"long_query_model{spec.number}_{name}_at_{n}_rows", 1e6 * seconds[name], "us"
+            n *= 2
+
+
+def _query_seconds(
+    spec: ModelSpec, rows: np.ndarray, rng: np.random.Generator, n_queries: int, passes: int
+) -> dict[str, float]:
+    """{'scan': s, 'trees': s}: seconds of a query of model `spec` holding `rows`, scanned
+    whole and through the trees; AssertionError if the two answer otherwise."""
+    context = rows[rng.integers(0, len(rows), n_queries), : len(spec.context_dims)]
+    queries = np.hstack((context, rng.uniform(-1.0, 1.0, (n_queries, BLOCK_DIM))))
+    answers, seconds = {}, {}
+    for name, tree_rows in (("scan", _NO_TREES), ("trees", TREE_ROWS)):
+        memory = NearestNeighbourMemory(rows.shape[1], tree_rows=tree_rows)
+        memory.extend(rows)
+        answers[name] = [memory.nearest_index(q) for q in queries]
+        seconds[name] = min(_time_queries(memory, queries) for _ in range(passes))
+    if answers["scan"] != answers["trees"]:
+        raise AssertionError(f"model {spec.number}: the trees answered otherwise")
+    return seconds
 
 
 def _time_queries(memory: NearestNeighbourMemory, queries: np.ndarray) -> float:
