@@ -19,5 +19,6 @@ SECTION_HELP = {
     "render": "offscreen rendering (needs OpenGL: MUJOCO_GL)",
     "emulated": "trial and learner again under the other CPU class's settings (a second process)",
     "long": "only when named: one trial of 10^6 iterations; cost per iteration and checkpoint "
-    "bytes near 80000 and near its end, peak memory (~4 min)",
+    "bytes near 80000 and near its end, peak memory; each model's query on its memories, "
+    "scanned whole and through the trees, and as they grew (~5 min)",
 }
