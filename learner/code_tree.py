@@ -173,44 +173,22 @@ def search_tree(
     shrink = 1.0 - rho  # the margin for the box's and the rows' rounding
     limit = screening_limit(nearest, eta, rho) if nearest < np.inf else np.float32(np.inf)
     lanes = np.empty(_LANES, np.float32)
-    weights = np.empty(FANOUT, np.float32)
-    stack_level = np.empty(_STACK, np.int64)
-    stack_node = np.empty(_STACK, np.int64)
-    stack_value = np.empty(_STACK, np.float32)
-    top = _push_block(
-        levels.shape[0] - 2,
-        0,
-        boxes,
-        levels,
-        query,
-        weights,
-        limit,
-        shrink,
-        stack_level,
-        stack_node,
-        stack_value,
-        0,
+    # The nodes waiting (level, node, box value) and the scratch their blocks are weighed in.
+    stack = (
+        np.empty(_STACK, np.int64),
+        np.empty(_STACK, np.int64),
+        np.empty(_STACK, np.float32),
+        np.empty(FANOUT, np.float32),
     )
+    stack_level, stack_node, stack_value, _ = stack
+    top = _push_block(levels.shape[0] - 2, 0, boxes, levels, query, limit, shrink, stack, 0)
     while top > 0:
         top -= 1
         level, node = stack_level[top], stack_node[top]
         if stack_value[top] * shrink > limit:
             continue
         if level > 0:
-            top = _push_block(
-                level - 1,
-                node,
-                boxes,
-                levels,
-                query,
-                weights,
-                limit,
-                shrink,
-                stack_level,
-                stack_node,
-                stack_value,
-                top,
-            )
+            top = _push_block(level - 1, node, boxes, levels, query, limit, shrink, stack, top)
             continue
         leaf = first_leaf + node
         squares_of_block(leaf_codes, leaf, LEAF_ROWS, query, block_squares)
@@ -233,21 +211,19 @@ def search_tree(
 
 @compiled
 def _push_block(
-    level,
-    block,
-    boxes,
-    levels,
-    query,
-    weights,
-    limit,
-    shrink,
-    stack_level,
-    stack_node,
-    stack_value,
-    top,
-):  # pragma: no cover - compiled
-    """Weigh the nodes of `block` of `level` and push those under the limit, nearest last
-    (on top); returns the new top."""
+    level: int,
+    block: int,
+    boxes: np.ndarray,
+    levels: np.ndarray,
+    query: np.ndarray,
+    limit: np.float32,
+    shrink: float,
+    stack: tuple,
+    top: int,
+) -> int:  # pragma: no cover - compiled
+    """Weigh the nodes of `block` of `level` and push those under the limit onto `stack`
+    (search_tree's), nearest last (on top); returns the new top."""
+    stack_level, stack_node, stack_value, weights = stack
     weigh_block(boxes, levels[level] + block, query, weights)
     start = top
     for j in range(FANOUT):

@@ -96,6 +96,7 @@ class NearestNeighbourMemory:
         self._scale = 1.0  # grid step is scale / CODE_MAX
         self._tree_rows = int(tree_rows)
         self._allocate(max(int(capacity), 1))
+        self._drop_trees()
 
     @property
     def dim(self) -> int:
@@ -222,6 +223,7 @@ class NearestNeighbourMemory:
         self._n = 0
         self._scale = 1.0
         self._allocate(_INITIAL_CAPACITY)
+        self._drop_trees()
         self.extend(rows)
 
     def nbytes(self) -> int:
@@ -247,8 +249,6 @@ class NearestNeighbourMemory:
         n_leaves = capacity // LEAF_ROWS if trees else 0
         self._order = np.empty(capacity if trees else 0, dtype=np.intp)
         self._leaf_codes = np.empty((n_leaves, self._dim, LEAF_ROWS), dtype=np.int8)
-        if self._n == 0:  # (a memory that grows keeps its trees' boxes)
-            self._drop_trees()
 
     def _reserve(self, n_rows: int) -> None:
         """Make room for n_rows, doubling the capacity as often as needed."""
