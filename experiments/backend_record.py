@@ -28,7 +28,7 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from experiments import storage
+from experiments import manifest, storage
 from experiments.config_file import with_added_settings
 from experiments.file_names import BACKEND_FILE
 from models import playroom_xml
@@ -47,20 +47,46 @@ def make_record(grasp: str, reach: float, capabilities: dict[str, bool]) -> dict
     return {"grasp": grasp, "reach": float(reach), **{k: bool(v) for k, v in capabilities.items()}}
 
 
-def write_once(trial_dir: str | os.PathLike, record: dict) -> None:
+def write_once(
+    trial_dir: str | os.PathLike, record: dict, recorded: manifest.Manifest | None
+) -> str | None:
     """Write a trial's record unless it has one: the first run (or, for a trial written before
-    records, the first resume) records what its backend declares."""
+    records, the first resume) records what its backend declares. One the trial's manifest
+    (`recorded`) holds but that is lost or damaged is written again when the backend still
+    declares exactly what was recorded (a line saying so is returned), and refused otherwise
+    (manifest.DamagedFileError, one line)."""
     path = Path(trial_dir) / BACKEND_FILE
-    if not path.exists():
-        storage.write_json(path, record)
+    if recorded is None or path not in recorded:
+        if not path.exists():
+            storage.write_json(path, record)
+        return None
+    try:
+        recorded.read_bytes(path, "")
+        return None
+    except manifest.DamagedFileError as exc:
+        problem = str(exc).split(":")[0]
+    data = storage.json_bytes(record)
+    if manifest.entry_of(data) != recorded.files[manifest.relative(recorded.trial_dir, path)]:
+        raise manifest.DamagedFileError(
+            f"{problem}, and the backend now declares another record than the trial wrote "
+            f"({record}): it cannot be regenerated; restore it from a backup"
+        )
+    storage.write_bytes(path, data)
+    return f"{problem}: regenerated from the backend's declaration, identical to the recorded one"
 
 
 def read_record(trial_dir: str | os.PathLike, config: dict) -> dict:
-    """A trial's record: its backend.json, or for a trial written before it, `recorded_before`
-    of its config.json. ValueError (one line) for a record without FIELDS;
-    storage.CorruptFileError for a backend.json that is not JSON."""
+    """A trial's record: its backend.json, checked against the trial's manifest, or for a
+    trial written before it, `recorded_before` of its config.json. ValueError (one line) for a
+    record without FIELDS; storage.CorruptFileError for a backend.json that is not JSON or not
+    what the trial recorded (manifest.DamagedFileError, saying how to regenerate it)."""
     path = Path(trial_dir) / BACKEND_FILE
-    record = storage.read_json(path) if path.exists() else recorded_before(config)
+    recorded = manifest.trial_manifest(trial_dir, warn=False)
+    if recorded is not None and path in recorded:
+        remedy = f"`playroom run --out {trial_dir} --resume` regenerates it"
+        record = storage.json_from_bytes(recorded.read_bytes(path, remedy), path)
+    else:
+        record = storage.read_json(path) if path.exists() else recorded_before(config)
     if not isinstance(record, dict) or set(FIELDS) - set(record):
         raise ValueError(f"{path} lacks the backend's {', '.join(FIELDS)}")
     return record

@@ -37,6 +37,9 @@ OLD_LOG_CHUNK_PATTERN = r"(?P<kind>iterations|words)-(?P<start>[0-9]{8})\.parque
 # (experiments/provenance.py), and where one that cannot be read is kept aside.
 PROVENANCE_FILE = "provenance.json"
 DAMAGED_PROVENANCE_FILE = "provenance.damaged.json"
+# Every data file the trial wrote, with its size and SHA-256, one file per checkpoint:
+# manifest/files-NNNNNNNN.json, NNNNNNNN the checkpoint's iteration (experiments/manifest.py).
+MANIFEST_DIR = "manifest"
 # What the trial's grasp backend declares of itself (its reach, its capabilities), written when
 # the trial first computes, for analysis to read (experiments/backend_record.py).
 BACKEND_FILE = "backend.json"
@@ -48,6 +51,7 @@ TRIAL_ENTRIES = (
     PREVIOUS_CHECKPOINT_FILE,
     DAMAGED_CHECKPOINT_FILE,
     MEMORY_DIR,
+    MANIFEST_DIR,
     LOG_DIR,
     LOCK_FILE,
     PROVENANCE_FILE,
@@ -63,6 +67,8 @@ COMPETENCE_FILE = "competence.parquet"
 VOCAL_FILE = "vocal.parquet"
 # The tests of the study's own measure (experiments/measure/study_measure.py).
 STUDY_TESTS_FILE = "study-tests.parquet"
+# The tables an evaluation writes beside eval.json, which lists them with their checksums.
+EVALUATION_TABLES = (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
 # Seconds and iterations of the batch task that last ran the trial.
 TIMING_FILE = "timing.json"
 
@@ -90,3 +96,8 @@ def memory_segment_name(start: int) -> str:
     """The name of the memory segment of the checkpoint period that starts at iteration
     `start`, in MEMORY_DIR."""
     return f"{MEMORY_SEGMENT_PREFIX}{start:08d}.npz"
+
+
+def manifest_name(iteration: int) -> str:
+    """The name of the manifest file the checkpoint at `iteration` names, in MANIFEST_DIR."""
+    return f"files-{iteration:08d}.json"

@@ -103,6 +103,13 @@ EXTENSIBLE = ("trial.iterations",)
 _NOT_IDENTITY = (*EXTENSIBLE, "package_version")
 
 
+# What a user can do about a log chunk that is missing, damaged or foreign: said after it.
+LOST_CHUNK_REMEDY = (
+    "the logs of a trial cannot be regenerated except by running it again from scratch (into "
+    "a new directory, with the settings in its config.json) or restored from a backup"
+)
+
+
 class DuplicateChunkError(storage.CorruptFileError):
     """A chunk found in both layouts: which one is the trial's cannot be told."""
 

@@ -178,8 +178,13 @@ def write_text(path: Path, text: str) -> None:
 
 
 def read_json(path: Path) -> Any:
+    return json_from_bytes(Path(path).read_bytes(), path)
+
+
+def json_from_bytes(data: bytes, path: Path) -> Any:
+    """The JSON text `data`, read from the file at `path` (named in the error)."""
     try:
-        return json.loads(path.read_text())
+        return json.loads(data.decode())
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise CorruptFileError(f"{path} is not valid JSON ({exc})") from None
 
@@ -203,10 +208,13 @@ def read_meta(path: Path) -> dict:
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
 
 
-def read_arrays(path: Path) -> tuple[dict[str, np.ndarray], dict]:
+def read_arrays(path: Path, data: bytes | None = None) -> tuple[dict[str, np.ndarray], dict]:
+    """The arrays and `meta` of a `write_arrays` file; from `data`, its bytes already read (and
+    checked), when given."""
+    source = path if data is None else io.BytesIO(data)
     try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
+        with np.load(source, allow_pickle=False) as loaded:
+            arrays = {k: loaded[k] for k in loaded.files}
         meta = json.loads(arrays.pop("__meta__").tobytes().decode())
     except (zipfile.BadZipFile, ValueError, KeyError, OSError, EOFError) as exc:
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
@@ -218,29 +226,35 @@ def write_table(path: Path, table: pd.DataFrame, plain: Sequence[str] = ()) -> N
     write_bytes(path, table_bytes(table, plain))
 
 
-def read_table(path: Path, columns: Sequence[str] | None = None) -> pd.DataFrame:
+def read_table(
+    path: Path, columns: Sequence[str] | None = None, data: bytes | None = None
+) -> pd.DataFrame:
     """A table written by `write_table`; with `columns`, only those of them it holds (a log
     written before a column existed lacks it), in that order: a reader that needs a few
-    columns of a wide table decodes only them."""
+    columns of a wide table decodes only them. From `data`, its bytes already read (and
+    checked), when given."""
     try:
         if columns is None:
-            return pd.read_parquet(path)
+            return pd.read_parquet(path if data is None else io.BytesIO(data))
         import pyarrow.parquet as pq
 
-        held = set(pq.read_schema(path).names)
-        return pd.read_parquet(path, columns=[c for c in columns if c in held])
+        held = set(pq.read_schema(path if data is None else io.BytesIO(data)).names)
+        kept = [c for c in columns if c in held]
+        return pd.read_parquet(path if data is None else io.BytesIO(data), columns=kept)
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
 
 
-def read_column(path: Path, name: str) -> list:
+def read_column(path: Path, name: str, data: bytes | None = None) -> list:
     """One column of a table written by `write_table`, as a list; every column is read and
     decoded (a check that the whole file is readable, at half the cost of `read_table`).
-    CorruptFileError if the file cannot be read or lacks the column."""
+    CorruptFileError if the file cannot be read or lacks the column. From `data`, its bytes
+    already read (and checked), when given."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
     try:
-        table = pq.read_table(path)
+        table = pq.read_table(path if data is None else pa.BufferReader(data))
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
     if name not in table.column_names:

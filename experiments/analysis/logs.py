@@ -20,17 +20,20 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import storage
+from experiments import manifest, storage
+from experiments.analysis.batch_checks import check_batch
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
 from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import (
+    LOST_CHUNK_REMEDY,
     SOURCE_COLUMNS,
     check_chunk,
     check_kind,
     chunk_identity,
     chunk_paths,
     is_trial_dir,
+    kind_dir,
     source_of,
     trial_identity,
 )
@@ -39,29 +42,51 @@ from experiments.log_layout import (
 def read_log(
     trial_dir: str | os.PathLike, kind: str = "iterations", columns: Sequence[str] | None = None
 ) -> pd.DataFrame:
-    """All chunks of one log ('iterations' or 'words') of a trial, in order, each row with its
-    source columns (filled from config.json for logs written before rows carried them). An
-    empty DataFrame if the trial has no chunk of that kind yet. storage.CorruptFileError for a
-    chunk that cannot be read. `columns`: only those (of them, the ones the log has) beside the
-    source columns; a log's 47 columns take twice as long to read as the report's 10.
-    A chunk that carries another trial's identity than config.json's (or, without one, than
-    the other chunks') is a storage.CorruptFileError too, naming it and both identities."""
+    """All chunks of one log ('iterations' or 'words') of a trial, in order, up to its newest
+    checkpoint, each row with its source columns (filled from config.json for logs written
+    before rows carried them). An empty DataFrame if the trial has no chunk of that kind yet.
+    `columns`: only those (of them, the ones the log has) beside the source columns; a log's
+    47 columns take twice as long to read as the report's 10.
+
+    Every chunk is checked before it is read: against the manifest of the trial's newest
+    checkpoint (experiments/manifest.py: missing, damaged, replaced or stray chunks are a
+    manifest.DamagedFileError naming the chunk), and by the identity it carries (a chunk of
+    another trial is a ForeignChunkError); both are storage.CorruptFileError, one line. A
+    chunk past the newest checkpoint is a running trial's work in progress, not yet vouched
+    for: left out. A trial written before manifests is read unchecked, with an
+    UncheckedTrialWarning."""
+    frame, checked = _read_log(Path(trial_dir), kind, columns)
+    if not checked:
+        manifest.warn_unchecked(trial_dir)
+    return frame
+
+
+def _read_log(
+    trial_dir: Path, kind: str, columns: Sequence[str] | None
+) -> tuple[pd.DataFrame, bool]:
+    """`read_log`'s frame, and whether the trial's manifest checked it."""
     check_kind(kind)
+    recorded = manifest.trial_manifest(trial_dir, warn=False)
     chunks = chunk_paths(trial_dir, kind)
+    if recorded is not None:
+        chunks = _vouched_for(trial_dir, kind, chunks, recorded)
     if not chunks:
-        return pd.DataFrame()
-    config_path = Path(trial_dir) / CONFIG_FILE
+        return pd.DataFrame(), recorded is not None
+    config_path = trial_dir / CONFIG_FILE
     config = with_added_settings(storage.read_json(config_path)) if config_path.exists() else None
     own = _identity_of(config)
     wanted = None if columns is None else [*SOURCE_COLUMNS, *columns]
     frames = []
     for chunk in chunks.values():
+        data = chunk.read_bytes()
         if own is None:  # without a config.json, the first chunk's identity is the trial's
             found = chunk_identity(chunk)
             own = found if isinstance(found, dict) else None
         if own is not None:
             check_chunk(chunk, own, trial_dir)
-        frames.append(storage.read_table(chunk, wanted))
+        if recorded is not None:
+            recorded.verify(chunk, data, LOST_CHUNK_REMEDY)
+        frames.append(storage.read_table(chunk, wanted, data))
     frame = pd.concat(frames, ignore_index=True)
     missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
     if missing and config is not None:
@@ -69,7 +94,29 @@ def read_log(
         for position, column in enumerate(SOURCE_COLUMNS):
             if column in missing:
                 frame.insert(position, column, source[column])
-    return frame
+    return frame, recorded is not None
+
+
+def _vouched_for(
+    trial_dir: Path, kind: str, chunks: dict[int, Path], recorded: manifest.Manifest
+) -> dict[int, Path]:
+    """The chunks the trial's newest checkpoint vouches for; manifest.DamagedFileError for one
+    it recorded that is missing, or one before it that it did not record (a stray copy)."""
+    folder = kind_dir(trial_dir, kind)
+    for name in recorded.files:
+        path = trial_dir / name
+        if path.parent == folder and not path.exists():
+            raise manifest.DamagedFileError(f"{path} is missing: {LOST_CHUNK_REMEDY}")
+    kept = {}
+    for start, path in chunks.items():
+        if path in recorded:
+            kept[start] = path
+        elif start < recorded.iteration:
+            raise manifest.DamagedFileError(
+                f"{path} is not among the files the trial's checkpoint recorded (a stray or "
+                f"foreign file?): {LOST_CHUNK_REMEDY}"
+            )
+    return kept
 
 
 def _identity_of(config: dict | None) -> dict | None:
@@ -96,7 +143,10 @@ def read_batch_logs(
     backend, voice). ValueError (one line) for a folder that holds no trial directory.
     Trials that have not run to their end (a batch still running) are named in an
     `IncompleteTrialsWarning` and left out unless `include_incomplete`
-    (experiments/analysis/finished.py)."""
+    (experiments/analysis/finished.py). The batch is checked as `playroom report` checks it
+    (experiments/analysis/batch_checks.py: BatchMismatch, a ValueError, for two copies of a
+    trial or a trial of other settings), and every chunk as `read_log` checks it; trials
+    written before manifests are named in one UncheckedTrialWarning."""
     check_kind(kind)
     dirs = trial_dirs(batch_dir)
     if not dirs:
@@ -108,5 +158,13 @@ def read_batch_logs(
     if incomplete:
         warn_unfinished(batch_dir, incomplete, kept=include_incomplete)
         dirs = dirs if include_incomplete else [d for d in dirs if d not in incomplete]
-    frames = [frame for frame in (read_log(d, kind) for d in dirs) if not frame.empty]
+    configs = [with_added_settings(storage.read_json(d / CONFIG_FILE)) for d in dirs]
+    check_batch(Path(batch_dir), dirs, configs, frozenset(incomplete))
+    frames, unchecked = [], []
+    for d in dirs:
+        frame, checked = _read_log(d, kind, None)
+        unchecked += [] if checked else [d.name]
+        frames += [] if frame.empty else [frame]
+    if unchecked:
+        manifest.warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()

@@ -12,16 +12,17 @@ that the CLI can print it as it is.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from experiments import backend_record, storage
+from experiments import backend_record, manifest, storage
+from experiments.analysis.batch_checks import BatchMismatch, check_group, group_label, shared_config
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
 from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.logs import read_log
@@ -135,20 +136,24 @@ def _read_json(path: Path) -> Any:
         raise ReportError(str(exc)) from None
 
 
-def _read_table(path: Path) -> pd.DataFrame:
-    if not path.exists():
-        raise ReportError(f"{path} is missing: evaluate the trial again (`playroom eval`)")
+def _read_table(path: Path, summary: dict) -> pd.DataFrame | None:
+    """A table of a trial's evaluation, checked against its eval.json (`summary`); None for a
+    table that an evaluation from before it existed lacks."""
     try:
-        return storage.read_table(path)
+        data = manifest.read_evaluation_file(path.parent, path.name, summary)
+        if data is None:
+            return None
+        return storage.read_table(path, data=data)
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
 
 
-def shared_config(config: dict) -> dict:
-    """A trial's config without its seed: what must agree within a group."""
-    shared = json.loads(json.dumps(config))  # a deep copy, so the seed is popped from a copy
-    shared.get("trial", {}).pop("seed", None)
-    return shared
+def _evaluation_table(path: Path, summary: dict) -> pd.DataFrame:
+    """A table every evaluation writes; ReportError if missing or damaged."""
+    table = _read_table(path, summary)
+    if table is None:
+        raise ReportError(f"{path} is missing: evaluate the trial again (`playroom eval`)")
+    return table
 
 
 def _names(paths: list[Path], limit: int = 5) -> str:
@@ -187,31 +192,13 @@ def check_out_dir(out_dir: Path) -> None:
         raise ReportError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
 
 
-def _group_label(grasp: str, babbling: str, mixed_babbling: bool) -> str:
-    return f"{grasp} {babbling}" if mixed_babbling else grasp
-
-
 def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[dict]) -> None:
-    """Every setting but the seed agrees; seeds are distinct; every trial was evaluated at its
-    end on the same number of placements."""
-    reference = shared_config(configs[0])
-    for d, config in zip(dirs[1:], configs[1:], strict=True):
-        differences = storage.config_differences(reference, shared_config(config))
-        if differences:
-            key, a, b = differences[0]  # the first is enough to find the culprit
-            raise ReportError(
-                f"trials of mismatched configs in group {label}: {dirs[0].name} and "
-                f"{d.name} differ in {key} ({a!r} != {b!r})"
-            )
-    seen: dict[int, Path] = {}
-    for d, config in zip(dirs, configs, strict=True):
-        seed = config["trial"]["seed"]
-        if seed in seen:
-            raise ReportError(
-                f"seed {seed} appears twice in group {label} ({seen[seed].name}, {d.name}): "
-                "a trial copied twice would count double"
-            )
-        seen[seed] = d
+    """Every setting but the seed agrees; seeds are distinct (experiments/analysis/
+    batch_checks.py); every trial was evaluated at its end on the same number of placements."""
+    try:
+        check_group(label, dirs, configs)
+    except BatchMismatch as exc:
+        raise ReportError(str(exc)) from None
     for d, config, summary in zip(dirs, configs, evals, strict=True):
         if summary.get("evaluated_at_iteration") != config["trial"]["iterations"]:
             raise ReportError(
@@ -303,8 +290,8 @@ def _trial_rows(
     """(trials row, competence rows, vocal rows, curve rows, the study's test rows or None) of
     one trial directory."""
     keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
-    comp = _read_table(d / COMPETENCE_FILE).assign(**keys)
-    voc = _read_table(d / VOCAL_FILE).assign(**keys)
+    comp = _evaluation_table(d / COMPETENCE_FILE, summary).assign(**keys)
+    voc = _evaluation_table(d / VOCAL_FILE, summary).assign(**keys)
     log, words = _read_logs(d)
     reach = backend_record.study_reach(config["world"])  # one yardstick for every backend
     names = set(voc.loc[voc["is_name"], "word"])
@@ -325,9 +312,22 @@ def _trial_rows(
         "seconds": seconds,
         "timed_iterations": timed,
     }
-    study_path = d / STUDY_TESTS_FILE  # trials evaluated before it existed have none
-    study = _read_table(study_path).assign(**keys) if study_path.exists() else None
+    study = _read_table(d / STUDY_TESTS_FILE, summary)  # none: evaluated before it existed
+    study = None if study is None else study.assign(**keys)
     return row, comp, voc, curve, study
+
+
+def _warn_once_for_unchecked(
+    batch_dir: Path, dirs: list[Path], caught: list[warnings.WarningMessage]
+) -> None:
+    """The warnings reading the trials raised, again, those of trials written before manifests
+    as one line for the batch (experiments/manifest.py)."""
+    unchecked = [d.name for d in dirs if any(str(d) in str(w.message) for w in caught)]
+    for w in caught:
+        if not issubclass(w.category, manifest.UncheckedTrialWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if unchecked:
+        manifest.warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
 
 
 def collect(batch_dir: str | os.PathLike) -> BatchResults:
@@ -352,7 +352,7 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
             raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
     # Babbling joins the label only when it tells groups apart, to keep labels short.
     mixed = len({c["trial"]["babbling"] for c in configs}) > 1
-    labels = [_group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
+    labels = [group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
     group_configs: dict[str, dict] = {}
     for label in sorted(set(labels)):
         members = [i for i, lab in enumerate(labels) if lab == label]
@@ -364,10 +364,13 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
         )
         group_configs[label] = shared_config(configs[members[0]])
 
-    rows = [
-        _trial_rows(d, config, summary, label)
-        for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
-    ]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", manifest.UncheckedTrialWarning)
+        rows = [
+            _trial_rows(d, config, summary, label)
+            for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
+        ]
+    _warn_once_for_unchecked(batch_dir, dirs, caught)
     trials, competence, vocal, curves, study = zip(*rows, strict=True)
     where = [
         row

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from experiments import storage
+from experiments import manifest, storage
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches.directory import check_directory
 from experiments.batches.progress import (
@@ -37,10 +37,12 @@ from experiments.batches.progress import (
 )
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.file_names import (
+    BACKEND_FILE,
     BATCH_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
     EVAL_FILE,
+    EVALUATION_TABLES,
     TIMING_FILE,
 )
 from experiments.measure.evaluation import EvaluationSettings
@@ -96,7 +98,16 @@ def is_complete(trial_dir: Path) -> bool:
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
         check_identity(trial_dir / CHECKPOINT_FILE, meta, config)
-        check_logs(trial_dir, int(meta["iteration"]))
+        # Every file as the trial's manifest recorded it (experiments/manifest.py), and the
+        # evaluation's tables as its eval.json lists them: a damaged one is run again, which
+        # mends what can be mended (backend.json, an evaluation) and says what cannot.
+        recorded = manifest.read_manifest(trial_dir, meta)
+        check_logs(trial_dir, int(meta["iteration"]), None, recorded)
+        backend = trial_dir / BACKEND_FILE
+        if recorded is not None and backend in recorded:
+            recorded.read_bytes(backend, "")
+        for name in EVALUATION_TABLES:
+            manifest.read_evaluation_file(trial_dir, name, summary)
     except (OSError, KeyError, storage.CorruptFileError, TrialError):
         return False
     return True

@@ -20,6 +20,7 @@ import errno
 import shlex
 import signal
 import sys
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -149,11 +150,28 @@ def _kept(args: argparse.Namespace, argv: list[str], then: str = "") -> str:
         return ""
 
 
+@contextmanager
+def warnings_as_lines(prefix: str) -> Iterator[None]:
+    """While the block runs, each warning is one line on stderr, `PREFIX warning: ...`, once
+    (what Python prints by default is two lines, the second one of the project's source)."""
+    shown: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        text = " ".join(str(message).split())
+        if text not in shown:
+            shown.add(text)
+            print(f"{prefix} warning: {text}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
+
+
 def run_command(args: argparse.Namespace, argv: list[str]) -> int:
     """Run the parsed command; its exit code (module docstring). Every way out but success
-    prints one line on stderr, `playroom COMMAND: ...`."""
+    prints one line on stderr, `playroom COMMAND: ...`; so does each warning."""
     prefix = f"playroom {args.command}:"
-    with signals_as_exceptions():
+    with signals_as_exceptions(), warnings_as_lines(prefix):
         try:
             args.func(args)
         except (UsageError, DivaDataMissing) as exc:  # DIVA's data is the user's to install

@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments.file_names import COMPETENCE_FILE
+from experiments import manifest, storage
+from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
 from experiments.measure.evaluation import EvaluationSettings, goal_trajectory, placements
 from experiments.run.trial_checks import load_trial
 from learner.agent import Agent
@@ -90,12 +91,14 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
     """`replay_table` of the first `n_trials` finished trials of each backend of a batch."""
     tables = []
     for grasp in GRASPS:
-        dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / "eval.json").exists())
+        dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / EVAL_FILE).exists())
         for trial_dir in dirs[:n_trials]:
             config, agent, room, _ = load_trial(trial_dir)
             table = replay_table(agent, room, EvaluationSettings())
             # The random command the evaluation played on each of these scenes, beside them.
-            evaluated = pd.read_parquet(trial_dir / COMPETENCE_FILE)
+            summary = storage.read_json(trial_dir / EVAL_FILE)
+            data = manifest.read_evaluation_file(trial_dir, COMPETENCE_FILE, summary)
+            evaluated = storage.read_table(trial_dir / COMPETENCE_FILE, data=data)
             random = evaluated[evaluated["ring"] == 1][["placement", "toy", "random_error"]]
             table = table.merge(random, on=["placement", "toy"], how="left")
             tables.append(table.assign(trial=trial_dir.name, grasp=grasp))

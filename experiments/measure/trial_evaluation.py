@@ -8,7 +8,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from experiments import provenance, storage
+from experiments import manifest, provenance, storage
 from experiments.file_names import (
     COMPETENCE_FILE,
     CONFIG_FILE,
@@ -82,8 +82,11 @@ def evaluate_trial(
             COMPETENCE_FILE: storage.table_bytes(competence),
             VOCAL_FILE: storage.table_bytes(vocal),
             STUDY_TESTS_FILE: storage.table_bytes(study),
-            EVAL_FILE: storage.json_bytes(storage.finite_or_null(summary)),
         }
+        # eval.json lists the tables it vouches for, with their sizes and checksums, so that
+        # a reader refuses a table lost, damaged or left from another evaluation.
+        summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(files)
+        files[EVAL_FILE] = storage.json_bytes(storage.finite_or_null(summary))
         storage.write_files(trial_dir, files)
     finally:
         lock.release()

@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import storage
+from experiments import manifest, storage
 from experiments.file_names import MEMORY_DIR, MEMORY_SEGMENT_PREFIX, memory_segment_name
 from experiments.log_layout import identity_text
 from learner.agent import Agent
@@ -139,7 +139,9 @@ def _joined(checkpoint: Path, arrays: dict[str, np.ndarray], meta: dict) -> dict
     held = on_disk(meta)
     parts: dict[str, list[np.ndarray]] = {f"model{n}.{p}": [] for n in held.rows for p in _PARTS}
     found = dict.fromkeys(held.rows, 0)
-    for path, rows, first in _segments(checkpoint, held.newest, meta.get("identity")):
+    # The segments' bytes are checked against the checkpoint's manifest, where it has one.
+    recorded = manifest.read_manifest(checkpoint.parent, meta)
+    for path, rows, first in _segments(checkpoint, held.newest, meta.get("identity"), recorded):
         for n in held.rows:
             motor, key = (rows.get(f"model{n}.{p}", np.zeros((0, 0))) for p in _PARTS)
             if first.get(str(n)) != found[n] or motor.ndim != 2 or len(motor) != len(key):
@@ -163,10 +165,11 @@ def _joined(checkpoint: Path, arrays: dict[str, np.ndarray], meta: dict) -> dict
 
 
 def _segments(
-    checkpoint: Path, newest: str | None, identity: object
+    checkpoint: Path, newest: str | None, identity: object, recorded: manifest.Manifest | None
 ) -> list[tuple[Path, dict[str, np.ndarray], dict]]:
     """(path, arrays, first_rows) of each segment that `previous` leads to from `newest`,
-    oldest first, each read whole and of the trial of `identity` (the checkpoint's)."""
+    oldest first, each read whole, as the checkpoint's manifest (`recorded`, if any) recorded
+    it, and of the trial of `identity` (the checkpoint's)."""
     found = []
     name, seen = newest, set()
     while name is not None:
@@ -176,8 +179,9 @@ def _segments(
         path = checkpoint.parent / MEMORY_DIR / name
         if not path.exists():
             raise storage.CorruptFileError(f"{path} is missing ({_of(checkpoint)})")
+        data = path.read_bytes()
         try:
-            arrays, meta = storage.read_arrays(path)
+            arrays, meta = storage.read_arrays(path, data)
         except storage.CorruptFileError as exc:
             raise storage.CorruptFileError(f"{exc} ({_of(checkpoint)})") from None
         if identity is not None and meta.get("identity") != identity:
@@ -185,6 +189,8 @@ def _segments(
                 f"{path} belongs to another trial ({identity_text(meta.get('identity'))}) than "
                 f"{checkpoint} ({identity_text(identity)}); refusing to mix them"
             )
+        if recorded is not None:  # checked after the identity, which names a foreign one
+            recorded.verify(path, data, _of(checkpoint))
         first = meta.get("first_rows")
         if not isinstance(first, dict):
             raise storage.CorruptFileError(f"{path} names no first rows ({_of(checkpoint)})")

@@ -16,25 +16,25 @@ from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import backend_record, provenance, storage
+from experiments import backend_record, manifest, provenance, storage
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
+    BACKEND_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
     LOCK_FILE,
     LOG_DIR,
     LOG_README_FILE,
+    MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
-    STALE_PREFIX,
-    TRIAL_ENTRIES,
 )
 from experiments.log_layout import (
     CHUNK_IDENTITY_KEY,
@@ -54,9 +54,11 @@ from experiments.run.trial_files import (
     WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
+    created_as,
     fresh_trial_parts,
     learner_values,
     log_row,
+    move_derived_aside,
     trial_identity,
     trial_path,
 )
@@ -96,6 +98,11 @@ class Trial:
             self.start_iteration = 0
             # What the memory's segments hold (none yet): each checkpoint writes the rest.
             self.memory = memory_segments.MemoryOnDisk({}, None, 0)
+            # The newest manifest file (experiments/manifest.py), and the data files written
+            # since it, which the next checkpoint records.
+            self.manifest_pointer: dict | None = None
+            self.recorded: manifest.Manifest | None = None
+            self.unrecorded: list[Path] = []
             if resume:
                 self._resume()
             readme = self.dir / LOG_DIR / LOG_README_FILE
@@ -105,12 +112,7 @@ class Trial:
                 self.notices += provenance.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()
                 )
-                # What its backend declares, for analysis to read (backend.json).
-                backend = self.room.backend
-                record = backend_record.make_record(
-                    backend.name, backend.reach(), backend.capabilities()
-                )
-                backend_record.write_once(self.dir, record)
+            self._record_backend()
         except BaseException:
             self.close()
             raise
@@ -118,6 +120,20 @@ class Trial:
     def close(self) -> None:
         """Give up the directory's lock."""
         self._lock.release()
+
+    def _record_backend(self) -> None:
+        """What the trial's backend declares, for analysis to read (backend.json): written once,
+        or rewritten when lost or damaged if the backend declares what the trial recorded."""
+        backend = self.room.backend
+        record = backend_record.make_record(backend.name, backend.reach(), backend.capabilities())
+        if self.finished and not (self.dir / BACKEND_FILE).exists() and self.recorded is None:
+            return  # a finished trial from before backend.json: read from its config instead
+        notice = backend_record.write_once(self.dir, record, self.recorded)
+        if notice is not None:
+            self.notices.append(notice)
+        path = self.dir / BACKEND_FILE
+        if self.recorded is None or path not in self.recorded:
+            self.unrecorded.append(path)
 
     # Directory rules ----------------------------------------------------------------------
     def _refuse_foreign_path(self) -> None:
@@ -179,6 +195,13 @@ class Trial:
         memory = memory_segments.write_segment(
             self.dir, self.agent, self.memory, self.iteration, self.identity
         )
+        if memory.newest != self.memory.newest:
+            self.unrecorded.append(self.dir / MEMORY_DIR / str(memory.newest))
+        # Every file written since the last checkpoint, recorded before the checkpoint that
+        # names the record (experiments/manifest.py).
+        pointer = manifest.write_period(
+            self.dir, self.iteration, self.manifest_pointer, self.unrecorded, self.identity
+        )
         room_state = self.room.get_state()
         # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
         state = self.agent.state_dict(rows_from=memory.rows)
@@ -192,7 +215,10 @@ class Trial:
             "counts": self.counts,
             # Whose checkpoint it is: one copied into another trial is refused there.
             "identity": self.identity,
+            # The name the trial was created as, which its log rows carry wherever it lies.
+            "trial_name": self.source["trial"],
             memory_segments.MEMORY_KEY: memory.meta(),
+            manifest.MANIFEST_KEY: pointer,
         }
         newest = self.dir / CHECKPOINT_FILE
         if newest.exists():
@@ -200,6 +226,7 @@ class Trial:
             os.replace(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
         storage.write_arrays(newest, arrays, meta)
         self.memory = memory
+        self.manifest_pointer, self.unrecorded = pointer, []
 
     def _resume(self) -> None:
         """Load the newest usable checkpoint (its logs checked before anything is changed),
@@ -207,14 +234,21 @@ class Trial:
         iterations are asked for than it was run with."""
         restored = prepare_resume(self.dir, self.config, self.notices)
         if restored is not None:
-            self.agent, self.room, meta = restored
+            self.agent, self.room, meta, self.recorded = restored
             self.iteration = int(meta["iteration"])
             self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
             self.counts = dict(meta["counts"])
             self.memory = memory_segments.on_disk(meta)
+            self.source["trial"] = created_as(self.dir, meta, str(self.source["trial"]))
+            self.manifest_pointer = meta.get(manifest.MANIFEST_KEY)
         # The lost work's, past the checkpoint: rewritten by the run.
         drop_logs_past(self.dir, self.iteration)
         memory_segments.drop_segments_past(self.dir, self.iteration)
+        manifest.drop_past(self.dir, self.iteration)
+        if restored is not None and self.manifest_pointer is None:
+            # A trial written before manifests: its next checkpoint records every data file
+            # it holds, as checked by the resume, and it is checked from then on.
+            self.unrecorded = manifest.data_files(self.dir)
         self._extend_if_asked()
 
     def _extend_if_asked(self) -> None:
@@ -228,24 +262,9 @@ class Trial:
                 f"{self.dir} holds {self.iteration} iterations already; --iterations {asked} "
                 "would shorten it"
             )
-        stale = self.dir / f"{STALE_PREFIX}{self.iteration:08d}"
-        # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a
-        # writer (one `remove_litter` spared): none is a result derived from the trial.
-        derived = [
-            p
-            for p in self.dir.iterdir()
-            if p.name not in TRIAL_ENTRIES
-            and not p.name.startswith(STALE_PREFIX)
-            and storage.temporary_writer(p.name) is None
-        ]
-        if derived:
-            stale.mkdir(exist_ok=True)
-            for path in derived:
-                shutil.move(path, stale / path.name)
-            self.notices.append(
-                f"extended from {stored_total} to {asked} iterations; the shorter run's "
-                f"{', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"
-            )
+        moved = move_derived_aside(self.dir, self.iteration)
+        if moved:
+            self.notices.append(f"extended from {stored_total} to {asked} iterations; {moved}")
         storage.write_json(config_path, self.config)
 
     # The loop -----------------------------------------------------------------------------
@@ -345,6 +364,7 @@ class Trial:
         # Written into the Parquet schema's metadata (experiments/log_layout.py).
         table.attrs[CHUNK_IDENTITY_KEY] = self.identity
         storage.write_table(path, table, plain=plain)
+        self.unrecorded.append(path)
 
 
 def run_trial(

@@ -17,9 +17,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments import storage
+from experiments import manifest, storage
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
+    BACKEND_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
@@ -29,6 +30,7 @@ from experiments.file_names import (
     PREVIOUS_CHECKPOINT_FILE,
 )
 from experiments.log_layout import (
+    LOST_CHUNK_REMEDY,
     DuplicateChunkError,
     ForeignChunkError,
     check_chunk,
@@ -74,8 +76,9 @@ def restore_newest(
 
 def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
     """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta).
-    TrialError unless its newest checkpoint is its own and readable and its logs up to it
-    whole: what is derived from it (an evaluation, a report) would not be the trial's."""
+    TrialError unless its newest checkpoint is its own and readable, and its logs up to it,
+    its memory segments and backend.json whole and as its manifest recorded them: what is
+    derived from it (an evaluation, a report) would not be the trial's."""
     trial_dir = Path(trial_dir)
     if not (trial_dir / CONFIG_FILE).exists():
         raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
@@ -91,8 +94,31 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
         )
     if meta["iteration"] == 0:
         raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
-    check_logs(trial_dir, int(meta["iteration"]), config)
+    recorded = _recorded(trial_dir, meta)
+    check_logs(trial_dir, int(meta["iteration"]), config, recorded)
+    if recorded is None:
+        manifest.warn_unchecked(trial_dir)
+    else:
+        _check_backend(trial_dir, recorded)
     return config, agent, room, meta
+
+
+def _recorded(trial_dir: Path, meta: dict) -> manifest.Manifest | None:
+    """The manifest of a restored checkpoint (its chain already read once by the restore)."""
+    try:
+        return manifest.read_manifest(trial_dir, meta)
+    except storage.CorruptFileError as exc:
+        raise TrialError(_first_line(exc)) from None
+
+
+def _check_backend(trial_dir: Path, recorded: manifest.Manifest) -> None:
+    """TrialError unless backend.json is as the trial recorded it (when it recorded one)."""
+    path = trial_dir / BACKEND_FILE
+    if path in recorded:
+        try:
+            recorded.read_bytes(path, f"`playroom run --out {trial_dir} --resume` regenerates it")
+        except storage.CorruptFileError as exc:
+            raise TrialError(str(exc)) from None
 
 
 def _chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
@@ -104,14 +130,20 @@ def _chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
         raise TrialError(f"{exc}; nothing was changed") from None
 
 
-def check_logs(trial_dir: str | os.PathLike, iteration: int, config: dict | None = None) -> None:
+def check_logs(
+    trial_dir: str | os.PathLike,
+    iteration: int,
+    config: dict | None = None,
+    recorded: manifest.Manifest | None = None,
+) -> None:
     """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
     is missing, unreadable, of another trial than `config`'s (the trial's config.json if None),
-    or holds other rows than its name and period say: the iterations chunks hold 0 to
-    `iteration` - 1 without a gap, each words chunk the multiples of WORDS_LOG_PERIOD its
-    iterations chunk reaches. Chunks starting at `iteration` or later are work past the
-    checkpoint (a resume rewrites them) and are not looked at. Chunks of both layouts
-    (log/iterations/ and log/words/, or side by side in log/) are read."""
+    not as the checkpoint's manifest (`recorded`, None for a trial from before manifests)
+    recorded it, not recorded there, or holds other rows than its name and period say: the
+    iterations chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
+    WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later are
+    work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of both
+    layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
     trial_dir = Path(trial_dir)
     if config is None:
         config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
@@ -120,6 +152,10 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int, config: dict | None
         kind: {s: p for s, p in _chunks(trial_dir, kind).items() if s < iteration}
         for kind in LOG_KINDS
     }
+    if recorded is not None:
+        stray = [p for kind in LOG_KINDS for p in found[kind].values() if p not in recorded]
+        if stray:
+            raise TrialError(_lost(f"{stray[0]} is not among the files the trial recorded"))
     start = 0
     while start < iteration:
         if start not in found["iterations"]:
@@ -127,7 +163,9 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int, config: dict | None
             end = min((s for s in found["iterations"] if s > start), default=iteration)
             raise TrialError(_lost(f"{path} is missing (iterations {start} to {end - 1})"))
         path = found["iterations"][start]
-        end = start + _check_rows(path, range(start, iteration), (trial_dir, own), whole=False)
+        end = start + _check_rows(
+            path, range(start, iteration), (trial_dir, own), recorded, whole=False
+        )
         # The words rows this period reached: the multiples of the period in (start, end].
         reached = range(
             (start // WORDS_LOG_PERIOD + 1) * WORDS_LOG_PERIOD, end + 1, WORDS_LOG_PERIOD
@@ -136,21 +174,31 @@ def check_logs(trial_dir: str | os.PathLike, iteration: int, config: dict | None
         if reached and not words.exists():
             raise TrialError(_lost(f"{words} is missing (words at {reached[0]} to {reached[-1]})"))
         if words.exists():
-            _check_rows(words, reached, (trial_dir, own), whole=True)
+            _check_rows(words, reached, (trial_dir, own), recorded, whole=True)
         start = end
     for words in found["words"].values():
         raise TrialError(_lost(f"{words} starts where no iterations chunk starts"))
 
 
-def _check_rows(path: Path, expected: range, trial: tuple[Path, dict], whole: bool) -> int:
+def _check_rows(
+    path: Path,
+    expected: range,
+    trial: tuple[Path, dict],
+    recorded: manifest.Manifest | None,
+    whole: bool,
+) -> int:
     """The number of rows of a log chunk of `trial` (its directory and identity), whose
-    iterations must be the first of `expected` (all of them if `whole`); TrialError naming the
-    chunk otherwise."""
+    iterations must be the first of `expected` (all of them if `whole`), and whose bytes must be
+    those the trial's manifest recorded (if it has one); TrialError naming the chunk
+    otherwise."""
     try:
-        rows = storage.read_column(path, "iteration")
-        check_chunk(path, trial[1], trial[0])
-    except ForeignChunkError as exc:
-        raise TrialError(_lost(str(exc))) from None
+        data = path.read_bytes()
+        check_chunk(path, trial[1], trial[0])  # first: it names a foreign chunk as such
+        if recorded is not None:
+            recorded.verify(path, data, "")
+        rows = storage.read_column(path, "iteration", data)
+    except (ForeignChunkError, manifest.DamagedFileError) as exc:
+        raise TrialError(_lost(str(exc).removesuffix(": "))) from None
     except storage.CorruptFileError as exc:
         raise TrialError(_lost(_first_line(exc))) from None
     if not rows or rows != list(expected[: len(rows)]) or (whole and len(rows) != len(expected)):
@@ -165,11 +213,7 @@ def _first_line(exc: Exception) -> str:
 
 def _lost(problem: str) -> str:
     """One line: a log chunk that is not whole (`problem` names it), and the only ways back."""
-    return (
-        f"{problem}: the logs of a trial cannot be regenerated except by running it again "
-        "from scratch (into a new directory, with the settings in its config.json) or restored "
-        "from a backup; nothing was changed"
-    )
+    return f"{problem}: {LOST_CHUNK_REMEDY}; nothing was changed"
 
 
 def _alive(pid: int) -> bool:
@@ -211,9 +255,10 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
 
 def prepare_resume(
     trial_dir: Path, config: dict, notices: list[str]
-) -> tuple[Agent, Playroom, dict] | None:
-    """What a resume starts from: (agent, room, checkpoint meta) of the newest usable
-    checkpoint whose logs are whole, or None to start from iteration 0 (no checkpoint and no
+) -> tuple[Agent, Playroom, dict, manifest.Manifest | None] | None:
+    """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
+    checkpoint from before manifests) of the newest usable checkpoint whose logs are whole
+    and as recorded, or None to start from iteration 0 (no checkpoint and no
     logs yet). Everything is checked before anything is changed; then a damaged newest
     checkpoint is kept as checkpoint.damaged.npz and the litter of killed writers removed.
     Appends to `notices` one line per thing done or noticed. TrialError if the trial cannot
@@ -234,8 +279,9 @@ def prepare_resume(
         restored = None
     else:
         agent, room, meta, fallback = restore_newest(trial_dir, config)
-        check_logs(trial_dir, int(meta["iteration"]), config)
-        restored = agent, room, meta
+        recorded = _recorded(trial_dir, meta)
+        check_logs(trial_dir, int(meta["iteration"]), config, recorded)
+        restored = agent, room, meta, recorded
         if "identity" not in meta:
             notices.append(
                 "the checkpoint predates trial identities (no seed or config hash in it): "

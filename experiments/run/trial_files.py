@@ -33,13 +33,14 @@ from __future__ import annotations
 
 import errno
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
 
 from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
-from experiments.log_layout import identity_text, trial_identity
+from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, STALE_PREFIX, TRIAL_ENTRIES
+from experiments.log_layout import chunk_paths, identity_text, trial_identity
 from experiments.run import memory_segments
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
@@ -181,6 +182,45 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     except (KeyError, TypeError, ValueError) as exc:
         raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
     return agent, room
+
+
+def created_as(trial_dir: Path, meta: dict, default: str) -> str:
+    """The name a trial was created as, which every row of its logs carries however its
+    directory is renamed or moved: its checkpoint's record of it, or for a checkpoint from
+    before that record, the `trial` of its first log row (`default` where neither is)."""
+    name = meta.get("trial_name")
+    if isinstance(name, str):
+        return name
+    first = chunk_paths(trial_dir, "iterations")
+    if first:
+        try:
+            rows = storage.read_table(next(iter(first.values())), ["trial"])
+        except storage.CorruptFileError:
+            return default  # the resume's checks name the damage
+        if "trial" in rows and len(rows):
+            return str(rows["trial"].iloc[0])
+    return default
+
+
+def move_derived_aside(trial_dir: Path, iteration: int) -> str | None:
+    """Move what was derived from a trial at `iteration` (its evaluation, timing, videos) into
+    `stale-at-<iteration>/`, before the trial is extended; what was moved, in words, or None."""
+    stale = trial_dir / f"{STALE_PREFIX}{iteration:08d}"
+    # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a writer
+    # (one `remove_litter` spared): none is a result derived from the trial.
+    derived = [
+        p
+        for p in trial_dir.iterdir()
+        if p.name not in TRIAL_ENTRIES
+        and not p.name.startswith(STALE_PREFIX)
+        and storage.temporary_writer(p.name) is None
+    ]
+    if not derived:
+        return None
+    stale.mkdir(exist_ok=True)
+    for path in derived:
+        shutil.move(path, stale / path.name)
+    return f"the shorter run's {', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"
 
 
 def check_identity(path: Path, meta: dict, config: dict) -> None:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from old_trials import as_before_manifests
 from page_checks import check_explained
 from summary_checks import check_summary
 
@@ -292,6 +293,7 @@ def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypat
 def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
     batch = _copy_batch(batches, tmp_path / "<b>batch")
     for config_path in batch.glob("*/config.json"):
+        as_before_manifests(config_path.parent)  # edited by hand below: as an older trial
         config = json.loads(config_path.read_text())
         config["trial"]["grasp"] = "<script>alert(1)</script>"
         config_path.write_text(json.dumps(config))

@@ -9,6 +9,7 @@ import dataclasses
 import shutil
 from pathlib import Path
 
+from old_trials import as_before_manifests
 from trial_states import SEGMENTED, same_state
 
 from experiments import storage
@@ -49,6 +50,7 @@ def test_a_late_checkpoint_writes_about_the_bytes_of_an_early_one(tmp_path, monk
 def _as_old_format(out: Path) -> None:
     """Turn a trial's checkpoints into what they were before memory segments: every row in the
     checkpoint's own arrays, no memory entry in its metadata, no memory/ folder."""
+    as_before_manifests(out)  # segments came before manifests
     for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
         arrays, meta = read_checkpoint(out / name)
         del meta[MEMORY_KEY]

@@ -10,6 +10,7 @@ import shutil
 
 import pyarrow.parquet as pq
 import pytest
+from old_trials import as_before_manifests
 from test_trial_integrity import task_failure
 from trial_logs import same_logs
 
@@ -102,6 +103,7 @@ def test_chunks_written_before_chunks_carried_an_identity_are_read_and_resumed(
     trials, tmp_path, capsys
 ):
     out = _copy(trials, tmp_path)
+    as_before_manifests(out)  # which came after identities
     for kind in LOG_KINDS:  # as the code before wrote them: no identity in the schema
         for chunk in (out / LOG_DIR / kind).glob("*.parquet"):
             table = storage.read_table(chunk)

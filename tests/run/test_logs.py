@@ -9,6 +9,7 @@ import shutil
 import numpy as np
 import pandas as pd
 import pytest
+from old_trials import as_before_manifests
 from trial_logs import logs_of
 
 from experiments import storage
@@ -168,6 +169,7 @@ def _to_old_layout(trial_dir) -> None:
         if (log / kind).exists():
             (log / kind).rmdir()
     (log / LOG_README_FILE).unlink()
+    as_before_manifests(trial_dir)  # which came after the folders
 
 
 @pytest.fixture

@@ -9,6 +9,7 @@ import numpy as np
 from trial_logs import same_logs
 
 from experiments.file_names import CHECKPOINT_FILE
+from experiments.manifest import MANIFEST_KEY
 from experiments.run.memory_segments import read_checkpoint
 from experiments.run.settings import TrialSettings
 
@@ -17,10 +18,18 @@ from experiments.run.settings import TrialSettings
 SEGMENTED = TrialSettings(iterations=400, seed=3, checkpoint_every=100, preset="project")
 
 
+# What a checkpoint records of its directory rather than of the trial's state: the name the
+# trial was created as, and its manifest of files (whose bytes carry that name).
+_OF_THE_DIRECTORY = ("trial_name", MANIFEST_KEY)
+
+
 def same_state(a: Path, b: Path) -> None:
-    """Same newest checkpoint, read whole (arrays, their types, metadata), same logs."""
+    """Same newest checkpoint, read whole (arrays, their types, metadata but what it records of
+    its directory), same logs."""
     arrays_a, meta_a = read_checkpoint(Path(a) / CHECKPOINT_FILE)
     arrays_b, meta_b = read_checkpoint(Path(b) / CHECKPOINT_FILE)
+    for key in _OF_THE_DIRECTORY:
+        meta_a.pop(key, None), meta_b.pop(key, None)
     assert sorted(arrays_a) == sorted(arrays_b) and meta_a == meta_b
     for key in arrays_a:
         np.testing.assert_array_equal(arrays_a[key], arrays_b[key], err_msg=key)
