@@ -12,6 +12,7 @@ trial's own clock at every 1000 iterations, with nothing added to the trial to m
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -22,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments.file_names import CHECKPOINT_FILE, MEMORY_DIR
+from experiments import manifest
+from experiments.file_names import CHECKPOINT_FILE, MANIFEST_DIR, MEMORY_DIR, manifest_name
 from experiments.run.memory_segments import AGENT, read_checkpoint
 from learner.memory import TREE_ROWS, NearestNeighbourMemory
 from learner.sensorimotor_model import MODELS, ModelSpec
@@ -36,6 +38,8 @@ PERIOD = 1_000  # the trial's checkpoint period: one segment each
 COST_RATIO_TARGET = 2.0
 BYTES_RATIO_TARGET = 1.5
 PEAK_MEMORY_TARGET_MB = 4096
+# Issue 39's: checking every file of the trial against its manifest, under a second.
+MANIFEST_CHECK_TARGET_S = 1.0
 _NO_TREES = 2**62  # a memory that never sorts its rows into trees: the whole scan
 # The child prints its own peak resident memory after the trial (kB on Linux).
 _CHILD = (
@@ -63,6 +67,7 @@ def long_figures(
         early_cost, late_cost = (_cost(out, start, window) for start in (near, late))
         early_bytes, late_bytes = (_checkpoint_bytes(out, start) for start in (near, late))
         queries = list(query_figures(out))
+        checks = list(manifest_figures(out))
     yield f"long_cost_per_iteration_near_{near}", early_cost * 1e3, "ms"
     yield f"long_cost_per_iteration_near_{iterations}", late_cost * 1e3, "ms"
     ratio = late_cost / early_cost
@@ -73,6 +78,30 @@ def long_figures(
     yield "long_checkpoint_bytes_ratio", bytes_ratio, f"ratio (target <= {BYTES_RATIO_TARGET:g})"
     yield "long_peak_memory", peak_kb / 1024, f"MB (target < {PEAK_MEMORY_TARGET_MB})"
     yield from queries
+    yield from checks
+
+
+def manifest_figures(trial: Path, passes: int = 3) -> Iterator[tuple[str, float, str]]:
+    """What checking the trial's files against its manifest costs (experiments/manifest.py),
+    the best of `passes`: reading its chain and every file's presence and size, as a reader
+    does before it starts; and every file's SHA-256 besides, as all readers together do."""
+    check, every, files, size = math.inf, math.inf, 0, 0
+    for _ in range(passes):
+        start = time.perf_counter()
+        recorded = manifest.trial_manifest(trial)
+        if recorded is None:
+            raise RuntimeError(f"{trial} recorded no manifest")
+        recorded.check_present()
+        middle = time.perf_counter()
+        size = sum(len(recorded.read_bytes(trial / name, "")) for name in recorded.files)
+        check, every = min(check, middle - start), min(every, time.perf_counter() - start)
+        files = len(recorded.files)
+    yield "long_manifest_check", check, f"s ({files} files: chain, presence and sizes)"
+    yield (
+        "long_manifest_checksums",
+        every,
+        (f"s ({files} files, {size / 1e6:.0f} MB hashed; target < {MANIFEST_CHECK_TARGET_S:g})"),
+    )
 
 
 def query_figures(
@@ -145,6 +174,8 @@ def _cost(trial: Path, start: int, window: int) -> float:
 
 
 def _checkpoint_bytes(trial: Path, start: int) -> int:
-    """What one checkpoint writes there: the period's segment and a checkpoint (the final one's
-    size: a checkpoint's size does not grow with the trial)."""
-    return _segment(trial, start).stat().st_size + (trial / CHECKPOINT_FILE).stat().st_size
+    """What one checkpoint writes there: the period's segment, its manifest file and a
+    checkpoint (the final one's size: a checkpoint's size does not grow with the trial)."""
+    end = start + PERIOD
+    files = (_segment(trial, start), trial / MANIFEST_DIR / manifest_name(end))
+    return sum(p.stat().st_size for p in files) + (trial / CHECKPOINT_FILE).stat().st_size

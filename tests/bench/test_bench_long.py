@@ -23,10 +23,13 @@ def test_a_long_trial_gives_its_costs_bytes_and_peak_memory_with_the_targets():
         "long_peak_memory",
         "long_query_mean_scan",
         "long_query_mean_trees",
+        "long_manifest_check",
+        "long_manifest_checksums",
     }
     assert all(math.isfinite(v) and v > 0 for v, _ in figures.values())
     assert "target <= 2" in figures["long_cost_ratio"][1]
     assert "target <= 1.5" in figures["long_checkpoint_bytes_ratio"][1]
+    assert "target < 1" in figures["long_manifest_checksums"][1]
     # A checkpoint writes about the same bytes early and late (its period's rows only).
     assert 0.5 < figures["long_checkpoint_bytes_ratio"][0] < 2
     late, early = (
