@@ -22,8 +22,11 @@ SIM_SETTINGS = ("sim", "sim.config", "sim.vocal", "sim.vocal.config")
         ("import experiments.analysis.stats", SIMULATOR),
         ("import experiments.report.comparison", SIMULATOR),
         ("from experiments.analysis.logs import read_log, read_batch_logs", SIMULATOR),
-        # The log layout and the backend record: the writer's and the readers' shared files.
-        ("import experiments.log_layout, experiments.backend_record", SIMULATOR),
+        # The log layout and schema, the backend record: the writer's and readers' shared files.
+        (
+            "import experiments.log_layout, experiments.log_schema, experiments.backend_record",
+            SIMULATOR,
+        ),
         # Naming and checking the grasp backends imports none of them.
         ("from sim.grasping.names import GRASPS", ("mujoco", "dm_control", "numba")),
         # The parser reads the settings' allowed values from sim.config and learner.config.

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from experiments.log_layout import SOURCE_COLUMNS
+from experiments.log_schema import SOURCE_COLUMNS
 from models.layout import TOYS
 
 CURVE_POINTS = 40

@@ -4,12 +4,13 @@
     log = read_log("runs/demo/kinematic-random-seed0000")            # one row per iteration
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
-What the logs hold, column by column, and where their chunks lie: experiments/log_layout.py,
-which the writer (experiments/run/) writes by. Every row carries its source (`trial`, `seed`,
-`backend`, `voice`), so that rows of several trials keep apart; every chunk its trial's
-identity, so that a chunk copied from another trial is refused. Each kind also lies in its own
-folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so `pd.read_parquet("TRIAL/log/iterations")`
-reads exactly one kind (in the order of its chunks' names, which is the iterations' order).
+What the logs hold, column by column: experiments/log_schema.py; where their chunks lie:
+experiments/log_layout.py; the writer (experiments/run/) writes by both. Every row carries its
+source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials keep apart; every
+chunk its trial's identity, so that a chunk copied from another trial is refused. Each kind also
+lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
+`pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks'
+names, which is the iterations' order).
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ from experiments.analysis.finished import unfinished_trials, warn_unfinished
 from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import (
-    SOURCE_COLUMNS,
     check_chunk,
     check_kind,
     chunk_identity,
@@ -34,6 +34,7 @@ from experiments.log_layout import (
     source_of,
     trial_identity,
 )
+from experiments.log_schema import SOURCE_COLUMNS
 
 
 def read_log(

@@ -28,7 +28,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from experiments.log_layout import GOAL_COLUMNS, REACHED_COLUMNS
+from experiments.log_schema import GOAL_COLUMNS, REACHED_COLUMNS
 from models.layout import MODELS, TOYS
 
 # The iterations log's columns `trial_mechanisms` reads beyond experiments/analysis/curves.py's.
