@@ -5,12 +5,13 @@
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
 What the logs hold, column by column: experiments/log_schema.py; where their chunks lie:
-experiments/log_layout.py; the writer (experiments/run/) writes by both. Every row carries its
-source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials keep apart; every
-chunk its trial's identity, so that a chunk copied from another trial is refused. Each kind also
-lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
-`pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks'
-names, which is the iterations' order).
+experiments/log_layout.py; the writer (experiments/run/) writes by both. A trial written before
+a column existed reads it as the schema declares (missing, for what it did not record). Every
+row carries its source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials
+keep apart; every chunk its trial's identity, so that a chunk copied from another trial is
+refused. Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`),
+so `pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its
+chunks' names, which is the iterations' order).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from experiments.log_layout import (
     source_of,
     trial_identity,
 )
-from experiments.log_schema import SOURCE_COLUMNS
+from experiments.log_schema import SOURCE_COLUMNS, upgraded
 
 
 def read_log(
@@ -43,8 +44,10 @@ def read_log(
     """All chunks of one log ('iterations' or 'words') of a trial, in order, each row with its
     source columns (filled from config.json for logs written before rows carried them). An
     empty DataFrame if the trial has no chunk of that kind yet. storage.CorruptFileError for a
-    chunk that cannot be read. `columns`: only those (of them, the ones the log has) beside the
-    source columns; a log's 47 columns take twice as long to read as the report's 10.
+    chunk that cannot be read. `columns`: only those (of them, the ones the log has or the schema
+    declares) beside the source columns; a log's 47 columns take twice as long to read as the
+    report's 10. Columns the trial's chunks lack are added as experiments/log_schema.py declares
+    (`upgraded`: missing, where the trial did not record them).
     A chunk that carries another trial's identity than config.json's (or, without one, than
     the other chunks') is a storage.CorruptFileError too, naming it and both identities."""
     check_kind(kind)
@@ -64,6 +67,7 @@ def read_log(
             check_chunk(chunk, own, trial_dir)
         frames.append(storage.read_table(chunk, wanted))
     frame = pd.concat(frames, ignore_index=True)
+    frame = upgraded(frame, kind, columns)  # an older trial's chunks lack newer columns
     missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
     if missing and config is not None:
         source = source_of(trial_dir, config)

@@ -6,21 +6,32 @@ numbers stay, and docs/learning.md shows the declared table."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from experiments import storage
+from experiments.analysis.curves import curve_rows, grasp_rate_by_distance, tool_numbers
+from experiments.analysis.logs import read_log
+from experiments.analysis.mechanisms import LABELS, trial_mechanisms
 from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import chunk_path
 from experiments.log_schema import (
     GOAL_COLUMNS,
     ITERATION,
     ITERATIONS,
+    LEARNER_COLUMNS,
+    MOTOR_SPACE,
+    SOURCE_COLUMNS,
+    STICK_DISTANCE,
     STICK_GRASPED,
     STICK_RETURNED,
+    WORD_RECOGNISED,
     Older,
+    column_names,
     column_table,
     recorded,
     upgraded,
@@ -60,6 +71,56 @@ def test_recorded_logs_hold_the_declared_types():
         log = pd.read_parquet(path)
         assert set(log.columns) <= set(DECLARED), path.name
         assert {c: str(t) for c, t in log.dtypes.items()} == {c: DECLARED[c] for c in log}
+
+
+def test_an_older_trial_reads_its_missing_columns_as_declared_and_keeps_its_other_numbers(
+    tmp_path,
+):
+    raw = pd.read_parquet(KINEMATIC)  # no stick_distance, no stick_returned, no learner values
+    log = read_log(_trial(tmp_path, raw))
+    assert list(log.columns) == list(column_names("iterations"))
+    assert log[list(SOURCE_COLUMNS)].iloc[0].tolist() == [
+        "kinematic-seed11",
+        11,
+        "kinematic",
+        "vtl",
+    ]
+    # What the trial did not record is missing, never a value that counts: not False, not 0.
+    assert str(log[STICK_RETURNED].dtype) == "boolean" and log[STICK_RETURNED].isna().all()
+    assert log[STICK_DISTANCE].isna().all() and log[STICK_DISTANCE].dtype == np.float64
+    assert log[list(LEARNER_COLUMNS)].isna().all().all()
+    assert (log[list(LEARNER_COLUMNS)].dtypes == np.float32).all()
+    pd.testing.assert_frame_equal(log[list(raw.columns)], raw)  # what it recorded, as it was
+
+    numbers = trial_mechanisms(log, NAMES, WORDS)
+    never = [] if raw[WORD_RECOGNISED].isin(NAMES).any() else ["first_name_recognised"]
+    assert [k for k in LABELS if math.isnan(numbers[k])] == [*IMITATION, *never]
+    arm = raw[raw[MOTOR_SPACE] == "arm"]
+    assert numbers["stick_held"] == pytest.approx(1000 * arm[STICK_GRASPED].sum() / len(arm))
+    assert sum(numbers[f"model_share_{k}"] for k in range(1, 11)) == pytest.approx(1.0)
+
+    stick = tool_numbers(log, REACH)
+    assert math.isnan(stick["stick_in_reach"]) and math.isnan(stick["stick_returns"])
+    assert stick["stick_grasps_per_1000_arm"] == pytest.approx(numbers["stick_held"])
+    curves = curve_rows(log, pd.DataFrame(), 2000, NAMES, REACH)
+    assert set(curves["metric"]) == {"tool_use", "stick_grasp", "word_recognised"}
+
+
+def test_a_trial_that_gained_a_column_is_missing_it_only_where_it_did_not_record_it(tmp_path):
+    raw = pd.read_parquet(PHYSICAL)
+    older = raw.iloc[:1000].drop(columns=[STICK_DISTANCE, STICK_RETURNED])
+    log = read_log(_trial(tmp_path, older, raw.iloc[1000:].reset_index(drop=True)))
+    returned = log[STICK_RETURNED]
+    assert str(returned.dtype) == "boolean"
+    assert returned.iloc[:1000].isna().all() and returned.iloc[1000:].notna().all()
+    assert returned.iloc[1000:].astype(bool).tolist() == raw[STICK_RETURNED].iloc[1000:].tolist()
+    # A whole-trial number cannot be told from half the trial: missing, not a count of half.
+    stick = tool_numbers(log, REACH)
+    assert math.isnan(stick["stick_in_reach"]) and math.isnan(stick["stick_returns"])
+    # The grasp rate by distance uses the rows that say where the stick lay.
+    rates = grasp_rate_by_distance(log)
+    later = raw.iloc[1000:]
+    assert rates["iterations"].sum() == (later[MOTOR_SPACE] == "arm").sum()
 
 
 def test_a_log_that_lacks_nothing_is_read_as_it_is():
