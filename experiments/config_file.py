@@ -1,31 +1,54 @@
 """config.json across versions: settings added after trials were written.
 
 A trial's config.json holds every setting it ran with. A setting added later (the vocal tract,
-`voice`) is absent from older trials, which ran with the value the setting has by default
-then: `with_added_settings` fills it in when a config is read, so an old trial resumes, is
-evaluated and compared as it is; `identity_form` leaves such a setting out while it has that
-value, so that an old trial's checkpoints (which carry a hash of its config) stay its own.
-Pure functions of dicts: every reader of config.json can use them.
+`voice`) is absent from older trials, which ran with the value the setting declares beside its
+field as `before` (`dataclasses.field(metadata={BEFORE: ...})` in sim/config.py and
+sim/vocal/config.py): `with_added_settings` fills it in when a config is read, so an old trial
+resumes, is evaluated and compared as it is; `identity_form` leaves such a setting out while it
+has that value, so that an old trial's checkpoints (which carry a hash of its config) stay its
+own. Adding a world setting is its field with its `before`; nothing here changes.
+
+The trial's own settings (experiments/run/settings.py) lie above this module, in the stage that
+runs trials, which the readers of trials may not import; the only ones added since are choices
+of a world setting of their name (WORLD_CHOICES), which share its history.
+Pure functions of dicts, and the configs' plain dataclasses (no simulator): every reader of
+config.json can use them.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 
-# Dotted key -> the value every trial written before the setting existed ran with.
-ADDED_SETTINGS: dict[str, object] = {
-    "trial.voice": "vtl",
-    "world.voice": "vtl",
-    "world.stick_return_reach": None,
-    "world.push_objects": True,
-    "world.settle_between_movements": False,
-}
+from sim.config import BEFORE, WorldConfig
+from sim.vocal.config import VoiceConfig
+
+# The sections of config.json whose settings declare their earlier values beside their fields.
+SECTIONS = {"world": WorldConfig, "voice": VoiceConfig}
+# The trial settings that choose the world setting of their name (experiments/run/settings.py
+# copies them into the world): each ran, before it existed, with its world setting's value.
+WORLD_CHOICES = ("stick_return", "voice")
+
+
+def added_settings() -> dict[str, object]:
+    """Dotted key -> the value every trial written before the setting existed ran with, as the
+    settings declare it (module docstring)."""
+    added = {
+        f"{section}.{field.name}": field.metadata[BEFORE]
+        for section, cls in SECTIONS.items()
+        for field in dataclasses.fields(cls)
+        if BEFORE in field.metadata
+    }
+    for name in WORLD_CHOICES:
+        if f"world.{name}" in added:
+            added[f"trial.{name}"] = added[f"world.{name}"]
+    return added
 
 
 def with_added_settings(config: dict) -> dict:
     """A copy of a config with every added setting it lacks set to its earlier value."""
     out = copy.deepcopy(config)
-    for key, value in ADDED_SETTINGS.items():
+    for key, value in added_settings().items():
         node, last = _section(out, key)
         if node is not None and last not in node:
             node[last] = value
@@ -35,7 +58,7 @@ def with_added_settings(config: dict) -> dict:
 def identity_form(config: dict) -> dict:
     """A copy of a config without the added settings that hold their earlier value."""
     out = copy.deepcopy(config)
-    for key, value in ADDED_SETTINGS.items():
+    for key, value in added_settings().items():
         node, last = _section(out, key)
         if node is not None and node.get(last, value) == value:
             node.pop(last, None)

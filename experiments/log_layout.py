@@ -1,4 +1,4 @@
-"""How a trial's logs lie on disk and what their rows hold: the one description that the
+"""How a trial's logs lie on disk and which trial each chunk is: the one description that the
 writer (experiments/run/) writes by and every reader (experiments/analysis/logs.py, a resume's
 checks) reads by, below both stages so that neither imports the other for it.
 
@@ -15,27 +15,8 @@ settings that make the trial), so that a chunk copied from another trial is told
 there (JSON under b"PANDAS_ATTRS") and gives back to a reader of the chunk. Chunks written
 before they carried one are taken as their trial's, as they always were.
 
-What the rows hold. Every row of both kinds starts with its source (SOURCE_COLUMNS: `trial`,
-the trial directory's name; `seed`; `backend`, the grasp backend; `voice`, the vocal tract), so
-that rows of several trials keep apart. The iterations log, one row per iteration
-(experiments/run/trial_files.py `log_row` and `learner_values` fill it):
-- iteration; motor_space ("arm" or "voice"); model (the chosen model, 0-based into
-  models.layout.MODELS, -1 during the bootstrap's random motor babbling);
-- stick_distance (m, the handle from the arm's base before the movement), stick_grasped,
-  stick_moved_by, toy1/2/3_moved_by ("hand", "stick", "push", "caregiver" or ""),
-  word_recognised, caregiver_said, diverged, stick_returned;
-- goal_0..goal_9 (GOAL_COLUMNS): the sensory goal the agent chose, in its model's 10D block (5
-  samples of x then 5 of y; for the sound, of F1 then F2); NaN during the bootstrap (no goal);
-- reached_0..reached_9 (REACHED_COLUMNS): the outcome in that same block of the feedback, as
-  the learner reads it (clipped to [-1, 1] under the study preset), so that the attempt's
-  competence is -sqrt(sum((goal_i - reached_i)^2)); NaN during the bootstrap;
-- interest_0..interest_9 (INTEREST_COLUMNS): each model's interest (learning progress,
-  learner/interest.py) when the iteration's model was chosen, i.e. before this iteration's
-  attempt; column k is model k of `model`. Kept under random babbling too, where it chooses
-  nothing.
-Goals, outcomes and interests are LEARNER_DTYPE, float32 (7 significant digits); rows written
-before they were logged hold NaN there. The words log, one row every 100 iterations: iteration
-and, per word, the best distance reached so far to it (inf before the voice was used).
+What the rows hold: experiments/log_schema.py, which declares every column of both kinds once
+(its type, meaning, what older trials read as, and the change that added it).
 
 Pure functions of paths and dicts, reading only: no simulator, no learner.
 """
@@ -48,10 +29,8 @@ import os
 import re
 from pathlib import Path
 
-import numpy as np
-
 from experiments import storage
-from experiments.config_file import identity_form
+from experiments.config_file import identity_form, with_added_settings
 from experiments.file_names import (
     CONFIG_FILE,
     LOG_CHUNK_PREFIX,
@@ -60,30 +39,16 @@ from experiments.file_names import (
     OLD_LOG_CHUNK_PATTERN,
     log_chunk_name,
 )
-from models.layout import BLOCK_DIM, MODELS
-
-# The columns that say which trial a row comes from, first in every row.
-SOURCE_COLUMNS = ("trial", "seed", "backend", "voice")
-# The learner's columns of the iterations log: the goal and the outcome in the chosen model's
-# sensory block, and every model's interest (what each holds: above).
-GOAL_COLUMNS = tuple(f"goal_{i}" for i in range(BLOCK_DIM))
-REACHED_COLUMNS = tuple(f"reached_{i}" for i in range(BLOCK_DIM))
-INTEREST_COLUMNS = tuple(f"interest_{k}" for k in range(len(MODELS)))
-LEARNER_COLUMNS = (*GOAL_COLUMNS, *REACHED_COLUMNS, *INTEREST_COLUMNS)
-# Stored as float32: 7 significant digits are plenty to plot and average them, at half the size
-# of float64 (random goals hardly compress). The other columns keep their types.
-LEARNER_DTYPE = np.float32
+from experiments.log_schema import SOURCE_COLUMNS
 
 
 def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
-    """The source columns of a trial's rows, from its directory and config."""
-    trial = config["trial"]
-    return {
-        "trial": Path(trial_dir).resolve().name,
-        "seed": int(trial["seed"]),
-        "backend": str(trial["grasp"]),
-        "voice": str(trial.get("voice", "vtl")),
-    }
+    """The source columns of a trial's rows (log_schema.SOURCE_COLUMNS), from its directory
+    and config (of any version: a trial older than the voice setting ran with VocalTractLab)."""
+    trial = with_added_settings(config)["trial"]
+    name = Path(trial_dir).resolve().name
+    values = (name, int(trial["seed"]), str(trial["grasp"]), str(trial["voice"]))
+    return dict(zip(SOURCE_COLUMNS, values, strict=True))
 
 
 _CHUNK = re.compile(re.escape(LOG_CHUNK_PREFIX) + r"(?P<start>[0-9]{8})\.parquet")

@@ -40,6 +40,13 @@ UNPUSHED_DAMPING_FACTOR = 1e4
 # of 16 cases seen (random commands, seed 3, study preset); twice that.
 SETTLE_PHYSICS_STEPS = 100
 
+# The key of a field's metadata that holds the value every trial written before the field
+# existed ran with: a field added to a released config declares it beside itself, so that
+# an older trial's config.json reads, resumes and keeps its identity as it was
+# (experiments/config_file.py). Fields without it were in config.json before the first one
+# added this way (the vocal tract, f838cfe).
+BEFORE = "before"
+
 # The room's scale, which bounds every length and position setting (m). The table of
 # models/playroom.xml is 2.6 m square about the arm's base: a position on it lies within its
 # half width, and no two points of it are farther apart than its diagonal, 3.68 m.
@@ -84,22 +91,24 @@ class WorldConfig:
     # where the learning arm's grasp rate falls below half its rate at the start pose, measured
     # on physical trials (docs/protocol.md D14). None: only when no contact can take it (no
     # point of the handle geom within the arm's length plus the hand's and the handle's radii,
-    # 0.546 m), the rule of every trial written before this setting (experiments/config_file.py).
-    stick_return_reach: float | None = 0.53
+    # 0.546 m), the rule of every trial written before this setting.
+    stick_return_reach: float | None = dataclasses.field(default=0.53, metadata={BEFORE: None})
     # The vocal tract (sim/vocal/registry.py): "vtl", VocalTractLab, this project's; or "diva",
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
-    # D13).
-    voice: str = DEFAULT_TRACT
+    # D13). Trials written before the choice ran with VocalTractLab.
+    voice: str = dataclasses.field(default=DEFAULT_TRACT, metadata={BEFORE: DEFAULT_TRACT})
     # Ablation of pushing (issue 32, docs/comparison.md), never a default: False holds every
     # object that nothing holds where it lies (the physical backend multiplies its table
     # damping by UNPUSHED_DAMPING_FACTOR), so that, as in the kinematic rules, only a grasp, a
-    # catch or the caregiver moves an object. The kinematic backend never pushes.
-    push_objects: bool = True
+    # catch or the caregiver moves an object. The kinematic backend never pushes. Older trials
+    # pushed.
+    push_objects: bool = dataclasses.field(default=True, metadata={BEFORE: True})
     # Ablation of after-effects (issue 32), never a default: True lets the physical room settle
     # between movements (SETTLE_PHYSICS_STEPS with the arm at rest), so that objects left
     # overlapping by a release, the arm's return to rest or the caregiver's putting a toy down
-    # part before the next context is read, not during the next movement.
-    settle_between_movements: bool = False
+    # part before the next context is read, not during the next movement. Older trials did not
+    # settle.
+    settle_between_movements: bool = dataclasses.field(default=False, metadata={BEFORE: False})
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a

@@ -8,8 +8,8 @@ iterations each), in a long table (iteration, metric, value):
 - stick_in_reach: share of iterations that began with the stick's handle within the study's
   reach (arm length plus the world's grasp distance: one yardstick for every backend,
   experiments/backend_record.py `study_reach`); stick_returned: share of iterations after
-  which the experimenter returned the stick (logs written before these columns existed have
-  neither);
+  which the experimenter returned the stick (a trial written before these columns existed
+  recorded neither: it has no such curves, and its stick numbers are NaN);
 - best_distance_names, best_distance_distractors: mean best distance so far of the trial's
   names and distractors, wherever the words log has a row.
 """
@@ -19,8 +19,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from experiments.log_layout import SOURCE_COLUMNS
-from models.layout import TOYS
+from experiments.log_schema import (
+    ITERATION,
+    MOTOR_SPACE,
+    STICK_DISTANCE,
+    STICK_GRASPED,
+    STICK_RETURNED,
+    TOY_MOVED_BY,
+    WORD_RECOGNISED,
+    recorded,
+    word_columns,
+)
 
 CURVE_POINTS = 40
 # Metric -> the column of movements it is a share of.
@@ -34,34 +43,36 @@ RATES = {
 # The iterations log's columns `curve_rows` and `tool_numbers` read (a reader may read only
 # these: experiments/analysis/logs.read_log's `columns`).
 LOG_COLUMNS = (
-    "iteration",
-    "motor_space",
-    "stick_grasped",
-    "word_recognised",
-    "stick_distance",
-    "stick_returned",
-    *(f"{toy}_moved_by" for toy in TOYS),
+    ITERATION,
+    MOTOR_SPACE,
+    STICK_GRASPED,
+    WORD_RECOGNISED,
+    STICK_DISTANCE,
+    STICK_RETURNED,
+    *TOY_MOVED_BY,
 )
+# The columns of stick_in_reach and stick_returned, which older trials did not record.
+STICK_COLUMNS = (STICK_DISTANCE, STICK_RETURNED)
 
 
 def _events(log: pd.DataFrame, reach: float) -> pd.DataFrame:
     """Per iteration: arm, voice, all, and each metric of RATES (bool)."""
-    arm = log["motor_space"] == "arm"
-    voice = log["motor_space"] == "voice"
-    toy_columns = [c for c in log.columns if c.startswith("toy") and c.endswith("_moved_by")]
+    arm = log[MOTOR_SPACE] == "arm"
+    voice = log[MOTOR_SPACE] == "voice"
     frame = pd.DataFrame(
         {
             "arm": arm,
             "voice": voice,
             "all": True,
-            "tool_use": (log[toy_columns] == "stick").any(axis=1) & arm,
-            "stick_grasp": log["stick_grasped"].astype(bool) & arm,
-            "word_recognised": (log["word_recognised"] != "") & voice,
+            "tool_use": (log[list(TOY_MOVED_BY)] == "stick").any(axis=1) & arm,
+            "stick_grasp": log[STICK_GRASPED].astype(bool) & arm,
+            "word_recognised": (log[WORD_RECOGNISED] != "") & voice,
         }
     )
-    if "stick_distance" in log.columns:
-        frame["stick_in_reach"] = log["stick_distance"] <= reach
-        frame["stick_returned"] = log["stick_returned"].astype(bool)
+    # Only where every row recorded them: a stretch without would read as never in reach.
+    if recorded(log, STICK_COLUMNS):
+        frame["stick_in_reach"] = log[STICK_DISTANCE] <= reach
+        frame["stick_returned"] = log[STICK_RETURNED].astype(bool)
     return frame
 
 
@@ -71,7 +82,7 @@ def curve_rows(
     """A trial's curves (module docstring) from its iterations and words logs; `reach` (m)."""
     window = max(50, round(iterations / CURVE_POINTS / 50) * 50)
     frame = _events(log, reach)
-    frame["end"] = np.minimum((log["iteration"].to_numpy() // window + 1) * window, iterations)
+    frame["end"] = np.minimum((log[ITERATION].to_numpy() // window + 1) * window, iterations)
     sums = frame.groupby("end").sum()
     parts = []
     # A window without arm (or voice) movements has no rate: NaN, not a division warning.
@@ -84,16 +95,14 @@ def curve_rows(
                 )
     if not words.empty:
         # A word never approached has distance inf; it would make every mean inf.
-        # Every column but the iteration and the row's source is a word.
-        not_words = ["iteration", *SOURCE_COLUMNS]
-        values = words.drop(columns=not_words, errors="ignore").replace(np.inf, np.nan)
+        values = words[word_columns(words)].replace(np.inf, np.nan)
         for metric, chosen in (
             ("best_distance_names", [w for w in values.columns if w in names]),
             ("best_distance_distractors", [w for w in values.columns if w not in names]),
         ):
             means = values[chosen].mean(axis=1)
             parts.append(
-                pd.DataFrame({"iteration": words["iteration"], "metric": metric, "value": means})
+                pd.DataFrame({"iteration": words[ITERATION], "metric": metric, "value": means})
             )
     return pd.concat(parts, ignore_index=True)
 
@@ -120,12 +129,13 @@ def grasp_rate_by_distance(log: pd.DataFrame, bin_width: float = 0.01) -> pd.Dat
     (`grasps`) and their share (`rate`); bins without a movement are left out. Arm movements
     only: the physical hand grasps in no other, and the study's kinematic rule of the resting
     hand in vocal movements is not reaching. `log`: one trial's iterations log, or several
-    concatenated (logs predating `stick_distance` cannot say where the stick lay)."""
+    concatenated (rows of trials written before `stick_distance` cannot say where the stick lay:
+    they are left out)."""
     if bin_width <= 0:
         raise ValueError(f"bin_width must be positive, got {bin_width!r}")
-    arm = log[log["motor_space"] == "arm"]
-    index = np.floor(arm["stick_distance"].to_numpy(dtype=float) / bin_width).astype(int)
-    grouped = arm["stick_grasped"].astype(bool).groupby(index)
+    arm = log[(log[MOTOR_SPACE] == "arm") & log[STICK_DISTANCE].notna()]
+    index = np.floor(arm[STICK_DISTANCE].to_numpy(dtype=float) / bin_width).astype(int)
+    grouped = arm[STICK_GRASPED].astype(bool).groupby(index)
     table = pd.DataFrame({"iterations": grouped.size(), "grasps": grouped.sum().astype(int)})
     table["rate"] = table["grasps"] / table["iterations"]
     table.insert(0, "low", table.index * bin_width)

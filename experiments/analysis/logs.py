@@ -4,12 +4,14 @@
     log = read_log("runs/demo/kinematic-random-seed0000")            # one row per iteration
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
-What the logs hold, column by column, and where their chunks lie: experiments/log_layout.py,
-which the writer (experiments/run/) writes by. Every row carries its source (`trial`, `seed`,
-`backend`, `voice`), so that rows of several trials keep apart; every chunk its trial's
-identity, so that a chunk copied from another trial is refused. Each kind also lies in its own
-folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so `pd.read_parquet("TRIAL/log/iterations")`
-reads exactly one kind (in the order of its chunks' names, which is the iterations' order).
+What the logs hold, column by column: experiments/log_schema.py; where their chunks lie:
+experiments/log_layout.py; the writer (experiments/run/) writes by both. A trial written before
+a column existed reads it as the schema declares (missing, for what it did not record). Every
+row carries its source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials
+keep apart; every chunk its trial's identity, so that a chunk copied from another trial is
+refused. Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`),
+so `pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its
+chunks' names, which is the iterations' order).
 """
 
 from __future__ import annotations
@@ -27,7 +29,6 @@ from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import (
     LOST_CHUNK_REMEDY,
-    SOURCE_COLUMNS,
     check_chunk,
     check_kind,
     chunk_identity,
@@ -37,6 +38,7 @@ from experiments.log_layout import (
     source_of,
     trial_identity,
 )
+from experiments.log_schema import SOURCE_COLUMNS, upgraded
 
 
 def read_log(
@@ -45,8 +47,10 @@ def read_log(
     """All chunks of one log ('iterations' or 'words') of a trial, in order, up to its newest
     checkpoint, each row with its source columns (filled from config.json for logs written
     before rows carried them). An empty DataFrame if the trial has no chunk of that kind yet.
-    `columns`: only those (of them, the ones the log has) beside the source columns; a log's
-    47 columns take twice as long to read as the report's 10.
+    `columns`: only those (of them, the ones the log has or the schema declares) beside the
+    source columns; a log's 47 columns take twice as long to read as the report's 10. Columns
+    the trial's chunks lack are added as experiments/log_schema.py declares (`upgraded`:
+    missing, where the trial did not record them).
 
     Every chunk is checked before it is read: against the manifest of the trial's newest
     checkpoint (experiments/manifest.py: missing, damaged, replaced or stray chunks are a
@@ -88,6 +92,7 @@ def _read_log(
             recorded.verify(chunk, data, LOST_CHUNK_REMEDY)
         frames.append(storage.read_table(chunk, wanted, data))
     frame = pd.concat(frames, ignore_index=True)
+    frame = upgraded(frame, kind, columns)  # an older trial's chunks lack newer columns
     missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
     if missing and config is not None:
         source = source_of(trial_dir, config)

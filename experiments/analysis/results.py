@@ -39,6 +39,7 @@ from experiments.file_names import (
     VOCAL_FILE,
 )
 from experiments.log_layout import is_trial_dir
+from experiments.log_schema import DIVERGED
 from experiments.provenance import SHORT_FIELDS, computed_on
 
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
@@ -218,7 +219,7 @@ def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     try:
         # Only what the report reads of the iterations log (its curves, stick numbers and
         # divergences): half the time of reading all of it.
-        columns = dict.fromkeys((*LOG_COLUMNS, *MECHANISM_COLUMNS, "diverged"))
+        columns = dict.fromkeys((*LOG_COLUMNS, *MECHANISM_COLUMNS, DIVERGED))
         log = read_log(trial_dir, columns=tuple(columns))
         words = read_log(trial_dir, "words")
     except storage.CorruptFileError as exc:
@@ -306,7 +307,7 @@ def _trial_rows(
         "iterations": config["trial"]["iterations"],
         "n_placements": summary.get("n_placements"),
         **_eval_numbers(d, summary),
-        "diverged": int(log["diverged"].sum()),
+        "diverged": int(log[DIVERGED].sum()),
         **tool_numbers(log, reach),
         **trial_mechanisms(log, names, set(voc["word"])),
         "seconds": seconds,

@@ -22,14 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from experiments import storage
-from experiments.log_layout import (
-    LEARNER_COLUMNS,
-    LEARNER_DTYPE,
-    SOURCE_COLUMNS,
-    chunk_path,
-    old_chunks,
-    source_of,
-)
+from experiments.log_layout import chunk_path, old_chunks, source_of
+from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 
 
 def move_old_chunks(trial_dir: Path, config: dict) -> int:

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from experiments import storage
+from experiments.config_file import WORLD_CHOICES
 from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
@@ -51,7 +52,9 @@ class TrialSettings:
     # earlier choices (sim.config.world_preset, learner.config.learner_preset).
     preset: str = DEFAULT_PRESET
     # The vocal tract (models/tracts.py): "vtl" (VocalTractLab) or "diva" (the study's DIVA
-    # map, from the user's installed data: `playroom voice-data diva PATH`).
+    # map, from the user's installed data: `playroom voice-data diva PATH`). It chooses the
+    # world's `voice` (config_file.WORLD_CHOICES), whose field declares what trials written
+    # before the choice ran with.
     voice: str = DEFAULT_TRACT
     # Single settings changed after the preset, {"world": {...}, "learner": {...}}: one
     # departure switched at a time (ablations, docs/replication.md).
@@ -94,7 +97,7 @@ class TrialSettings:
 # Override sections, their configs, and the fields a trial setting owns: an override of one
 # would make config.json's "trial" section say something else than the world or learner does.
 OVERRIDABLE = {
-    "world": (WorldConfig, ("stick_return", "voice")),
+    "world": (WorldConfig, WORLD_CHOICES),
     "learner": (LearnerConfig, ("babbling",)),
 }
 
@@ -143,8 +146,7 @@ def full_config(
         world = world or world_preset(
             settings.preset,
             **{
-                "stick_return": settings.stick_return,
-                "voice": settings.voice,
+                **{name: getattr(settings, name) for name in WORLD_CHOICES},
                 **changes.get("world", {}),
             },
         )

@@ -36,15 +36,8 @@ from experiments.file_names import (
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.log_layout import (
-    CHUNK_IDENTITY_KEY,
-    EXTENSIBLE,
-    LEARNER_COLUMNS,
-    LEARNER_DTYPE,
-    SOURCE_COLUMNS,
-    chunk_path,
-    source_of,
-)
+from experiments.log_layout import CHUNK_IDENTITY_KEY, EXTENSIBLE, chunk_path, source_of
+from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 from experiments.run import estimate, memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config

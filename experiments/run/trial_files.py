@@ -15,9 +15,10 @@ A trial directory holds:
 - `log/words/chunk-NNNNNNNN.parquet`: every 100 iterations, the best distance reached so far to
   each of the 6 words, in the chunk of the period that reaches them;
   every row of both carries its source (trial, seed, backend, voice), and every chunk its
-  trial's identity, as checkpoints do; where the chunks lie and what every column holds is
-  experiments/log_layout.py, which this writer and every reader follow (trials of the old
-  layout too: log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet side by side);
+  trial's identity, as checkpoints do; where the chunks lie is experiments/log_layout.py and
+  what every column holds experiments/log_schema.py, which this writer and every reader follow
+  (trials of the old layout too: log/iterations-NNNNNNNN.parquet and log/words-NNNNNNNN.parquet
+  side by side);
 - `log/README.txt`: which folder of log/ to read (a reader of all of log/ stops on it);
 - `provenance.json`: the machine, libraries and commit that computed each stretch of
   iterations, one entry per run or resume (experiments/provenance.py);
@@ -41,10 +42,24 @@ import numpy as np
 from experiments import storage
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, STALE_PREFIX, TRIAL_ENTRIES
 from experiments.log_layout import chunk_paths, identity_text, trial_identity
+from experiments.log_schema import (
+    CAREGIVER_SAID,
+    DIVERGED,
+    EMPTY_ROW,
+    ITERATION,
+    MODEL,
+    MOTOR_SPACE,
+    STICK_DISTANCE,
+    STICK_GRASPED,
+    STICK_MOVED_BY,
+    STICK_RETURNED,
+    WORD_RECOGNISED,
+    moved_by,
+)
 from experiments.run import memory_segments
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
-from models.layout import BLOCK_DIM, TOYS, context_indices
+from models.layout import BLOCK_DIM, context_indices
 from sim import Playroom
 from sim import events as ev
 from sim.config import WorldConfig, config_from_dict
@@ -63,7 +78,7 @@ This folder holds a trial's logs, one folder per kind, one Parquet chunk per che
 The kinds have different rows: read one of the folders, not this one (this file stops a reader
 of the whole folder before it mixes them). Every row names its trial, seed, backend and voice.
 With the project installed: `from experiments.analysis.logs import read_log, read_batch_logs`;
-the columns are described in experiments/log_layout.py.
+the columns are described in experiments/log_schema.py.
 """
 
 _NO_BLOCK = np.full(BLOCK_DIM, np.nan)
@@ -86,52 +101,37 @@ class TrialLocked(TrialError):
     """Another process is writing into the trial directory."""
 
 
-_EMPTY_ROW = {
-    "iteration": 0,
-    "motor_space": "",
-    "model": -1,
-    "stick_distance": 0.0,
-    "stick_grasped": False,
-    "stick_moved_by": "",
-    **{f"{toy}_moved_by": "" for toy in TOYS},
-    "word_recognised": "",
-    "caregiver_said": "",
-    "diverged": False,
-    "stick_returned": False,
-}
-
-
 def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
     """One row of the iterations log: what was tried, in what context (10,), and what happened.
     `stick_distance` is the handle's distance from the arm's base before the movement (m)."""
     x, y = context_indices("stick")
-    row = dict(_EMPTY_ROW)  # every event column, as if nothing happened
-    row["iteration"] = iteration
-    row["motor_space"] = proposal.motor_space
-    row["model"] = -1 if proposal.model is None else int(proposal.model)
-    row["stick_distance"] = float(np.hypot(context[x], context[y]))
+    row = dict(EMPTY_ROW)  # every event column, as if nothing happened
+    row[ITERATION] = iteration
+    row[MOTOR_SPACE] = proposal.motor_space
+    row[MODEL] = -1 if proposal.model is None else int(proposal.model)
+    row[STICK_DISTANCE] = float(np.hypot(context[x], context[y]))
     for e in feedback.events:
         if e.kind == ev.STICK_GRASPED:
-            row["stick_grasped"] = True
+            row[STICK_GRASPED] = True
         elif e.kind == ev.STICK_MOVED:
-            row["stick_moved_by"] = e.by
+            row[STICK_MOVED_BY] = e.by
         elif e.kind == ev.TOY_MOVED:
-            row[f"{e.obj}_moved_by"] = e.by
+            row[moved_by(e.obj)] = e.by
         elif e.kind == ev.WORD_RECOGNISED:
-            row["word_recognised"] = e.word
+            row[WORD_RECOGNISED] = e.word
         elif e.kind == ev.CAREGIVER_SAID:
-            row["caregiver_said"] = e.word
+            row[CAREGIVER_SAID] = e.word
         elif e.kind == ev.DIVERGED:
-            row["diverged"] = True
+            row[DIVERGED] = True
         elif e.kind == ev.STICK_RETURNED:
-            row["stick_returned"] = True
+            row[STICK_RETURNED] = True
     return row
 
 
 def learner_values(
     proposal: Proposal, reached: np.ndarray | None, interests: np.ndarray
 ) -> np.ndarray:
-    """The learner's columns of an iteration's row (log_layout.LEARNER_COLUMNS), (30,): the goal
+    """The learner's columns of an iteration's row (log_schema.LEARNER_COLUMNS), (30,): the goal
     (NaN without one: the bootstrap's random motor babbling), the outcome in the goal's block
     (`Agent.outcome`, NaN without a model) and each model's interest when the model was
     chosen (`Agent.interests`, read before the iteration's attempt)."""

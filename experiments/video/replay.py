@@ -20,6 +20,7 @@ from experiments import storage
 from experiments.analysis.logs import read_log
 from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
+from experiments.log_schema import ITERATION, STICK_GRASPED, TOY_MOVED_BY, WORD_RECOGNISED
 from experiments.run.trial_files import fresh_trial_parts, log_row
 from experiments.video.episodes import (
     EpisodeRenderer,
@@ -29,7 +30,7 @@ from experiments.video.episodes import (
 )
 from experiments.video.recording import parse_size
 from learner.agent import Proposal
-from models.layout import MODELS, TOYS
+from models.layout import MODELS
 from models.world import Feedback
 
 
@@ -53,18 +54,17 @@ def highlights(log: pd.DataFrame) -> dict[str, int]:
     the hand), the first stick grasp, a toy caught by the stick, and a recognised word with the
     caregiver bringing the toy."""
     toy_by = {
-        by: pd.concat([log[f"{t}_moved_by"] == by for t in TOYS], axis=1).any(axis=1)
-        for by in ("hand", "stick", "caregiver")
+        by: (log[list(TOY_MOVED_BY)] == by).any(axis=1) for by in ("hand", "stick", "caregiver")
     }
     wanted = {
         "hand grasp": toy_by["hand"],
-        "first tool use": log["stick_grasped"],
+        "first tool use": log[STICK_GRASPED],
         "toy caught by the stick": toy_by["stick"],
-        "word brings a toy": toy_by["caregiver"] & (log["word_recognised"] != ""),
+        "word brings a toy": toy_by["caregiver"] & (log[WORD_RECOGNISED] != ""),
     }
     found = {}
     for name, mask in wanted.items():
-        hits = log["iteration"][mask]
+        hits = log[ITERATION][mask]
         if len(hits):
             found[name] = int(hits.iloc[0])
     return found
@@ -114,7 +114,7 @@ def render_trial(
     config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
     agent, room = fresh_trial_parts(config)
     voice_audio, word_audio = tract_audio(room)
-    logged_rows = log.set_index("iteration")
+    logged_rows = log.set_index(ITERATION)
     results: list[ReplayedIteration] = []
     bar = tqdm(total=wanted[-1] + 1, disable=not progress, desc="replay", unit="it")
     with EpisodeRenderer(size, fps, camera) as renderer:
@@ -139,8 +139,9 @@ def render_trial(
                 replayed = log_row(it, proposal, feedback, context)
                 # The events' columns: the log's other columns (its source, the learner's
                 # goal and interests) are not what filming could change.
-                row = {"iteration": it, **logged_rows.loc[it].to_dict()}
-                logged = {k: row.get(k) for k in replayed}
+                row = {ITERATION: it, **logged_rows.loc[it].to_dict()}
+                # What the trial did not record (written before a column existed) is None.
+                logged = {k: None if pd.isna(row.get(k)) else row.get(k) for k in replayed}
                 results.append(ReplayedIteration(it, logged, replayed))
             else:
                 agent.play(room)

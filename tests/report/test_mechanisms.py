@@ -10,14 +10,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments.analysis.mechanisms import (
-    GOAL_COLUMNS,
-    LABELS,
-    LOG_COLUMNS,
-    REACHED_COLUMNS,
-    trial_mechanisms,
-)
+from experiments.analysis.mechanisms import LABELS, LOG_COLUMNS, trial_mechanisms
 from experiments.analysis.strategies import held_strategy, share_intervals
+from experiments.log_schema import (
+    GOAL_COLUMNS,
+    REACHED_COLUMNS,
+    STICK_MOVED_BY,
+    WORD_RECOGNISED,
+)
 from experiments.report.mechanisms import ring_outcomes
 
 NAMES = {"oey", "uye", "iuo"}
@@ -76,9 +76,40 @@ def test_a_log_gives_where_exploration_went_and_what_was_heard(log):
     assert m["stick_pushed"] == 0
 
 
-def test_a_log_without_the_columns_gives_no_numbers_rather_than_wrong_ones(log):
-    m = trial_mechanisms(log.drop(columns=["goal_3"]), NAMES, WORDS)
-    assert all(math.isnan(v) for v in m.values())
+IMITATION = ("imitation_goals_per_name", "imitation_goals_per_distractor", "random_sound_goals")
+
+
+@pytest.mark.parametrize(
+    "dropped, missing",
+    [
+        (GOAL_COLUMNS[3], IMITATION),
+        (REACHED_COLUMNS[0], IMITATION),
+        (STICK_MOVED_BY, ("stick_held", "stick_pushed")),
+        (
+            WORD_RECOGNISED,
+            (
+                "recognised_names",
+                "recognised_distractors",
+                "first_name_recognised",
+                "name_recognised_after_toy_goal",
+            ),
+        ),
+    ],
+)
+def test_a_log_without_a_column_gives_no_number_from_it_and_every_other(log, dropped, missing):
+    whole = trial_mechanisms(log, NAMES, WORDS)
+    m = trial_mechanisms(log.drop(columns=[dropped]), NAMES, WORDS)
+    assert [k for k, v in m.items() if math.isnan(v)] == [k for k in LABELS if k in missing]
+    assert {k: v for k, v in m.items() if k not in missing} == {
+        k: v for k, v in whole.items() if k not in missing
+    }
+
+
+def test_goals_an_older_trial_did_not_log_give_no_imitation_numbers(log):
+    # As read_log reads a trial written before goals and outcomes were logged: NaN throughout.
+    older = log.assign(**dict.fromkeys((*GOAL_COLUMNS, *REACHED_COLUMNS), np.float32("nan")))
+    m = trial_mechanisms(older, NAMES, WORDS)
+    assert [k for k, v in m.items() if math.isnan(v)] == list(IMITATION)
 
 
 def _tests(strategies: list[str], contacts: list[str], trial: str) -> pd.DataFrame:

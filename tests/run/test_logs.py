@@ -17,13 +17,16 @@ from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.analysis.results import collect
 from experiments.batches.runner import is_complete
 from experiments.file_names import LOG_DIR, LOG_README_FILE
-from experiments.log_layout import (
+from experiments.log_layout import DuplicateChunkError
+from experiments.log_schema import (
     GOAL_COLUMNS,
     INTEREST_COLUMNS,
+    KINDS,
     LEARNER_COLUMNS,
     REACHED_COLUMNS,
     SOURCE_COLUMNS,
-    DuplicateChunkError,
+    WORD,
+    column_names,
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
@@ -66,6 +69,20 @@ def test_each_kind_reads_in_one_line_and_the_whole_folder_does_not(trial):
         pd.read_parquet(trial / LOG_DIR)
     readme = (trial / LOG_DIR / LOG_README_FILE).read_text()
     assert 'pd.read_parquet("TRIAL/log/iterations")' in readme
+
+
+def test_the_chunks_hold_the_declared_columns_in_order_and_type(trial):
+    words = list(storage.read_json(trial / "config.json")["voice"]["words"])
+    for kind, expected in (
+        ("iterations", list(column_names("iterations"))),
+        ("words", [*column_names("words"), *words]),
+    ):
+        declared = {n: c.dtype for c in (*KINDS[kind], WORD) for n in c.names}
+        for chunk in sorted((trial / LOG_DIR / kind).glob("*.parquet")):
+            table = pd.read_parquet(chunk)
+            assert list(table.columns) == expected, chunk.name
+            types = {c: declared.get(c, WORD.dtype) for c in table.columns}
+            assert {c: str(t) for c, t in table.dtypes.items()} == types, chunk.name
 
 
 def test_a_reader_of_a_few_columns_gets_them_as_the_whole_log_holds_them(trial):
@@ -191,8 +208,10 @@ def old_trial(tmp_path):
 
 def test_an_old_layout_trial_is_read_checked_and_evaluated(old_trial):
     old, new = old_trial
-    events = [c for c in logs_of(new).columns if c not in LEARNER_COLUMNS]
-    pd.testing.assert_frame_equal(logs_of(old), logs_of(new)[events])  # source from config
+    # The source from config.json; the learner's columns, which it did not log, missing.
+    expected = logs_of(new)
+    expected[list(LEARNER_COLUMNS)] = np.float32("nan")
+    pd.testing.assert_frame_equal(logs_of(old), expected)
     pd.testing.assert_frame_equal(logs_of(old, "words"), logs_of(new, "words"))
     check_logs(old, 120)
     evaluate_trial(old, EvaluationSettings(n_placements=1))
