@@ -181,11 +181,31 @@ def read_json(path: Path) -> Any:
     return json_from_bytes(Path(path).read_bytes(), path)
 
 
+class DuplicateKeyError(ValueError):
+    """A JSON object that names a key twice: which value was meant cannot be told."""
+
+
+def _refuse_duplicates(pairs: list[tuple[str, Any]]) -> dict:
+    found: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in found:
+            raise DuplicateKeyError(f"the key {key!r} appears twice in one object")
+        found[key] = value
+    return found
+
+
+def strict_json(text: str) -> Any:
+    """JSON text parsed as `json.loads` does, but a key given twice in one object is a
+    DuplicateKeyError (json.loads keeps the last one silently): every JSON file the project
+    reads is read so (issue 39)."""
+    return json.loads(text, object_pairs_hook=_refuse_duplicates)
+
+
 def json_from_bytes(data: bytes, path: Path) -> Any:
     """The JSON text `data`, read from the file at `path` (named in the error)."""
     try:
-        return json.loads(data.decode())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        return strict_json(data.decode())
+    except (json.JSONDecodeError, UnicodeDecodeError, DuplicateKeyError) as exc:
         raise CorruptFileError(f"{path} is not valid JSON ({exc})") from None
 
 

@@ -46,6 +46,11 @@ SETTLE_PHYSICS_STEPS = 100
 # (experiments/config_file.py). Fields without it were in config.json before the first one
 # added this way (the vocal tract, f838cfe).
 BEFORE = "before"
+# The key of a field's metadata that names the grasp backends (sim/grasping/registry.py) whose
+# rules read the field; a field without it acts in every backend. Changing such a field for a
+# trial of another backend would change nothing but its record, and is refused
+# (`inert_settings`).
+ACTS_ON = "acts_on"
 
 # The room's scale, which bounds every length and position setting (m). The table of
 # models/playroom.xml is 2.6 m square about the arm's base: a position on it lies within its
@@ -76,11 +81,11 @@ class WorldConfig:
     caregiver_box: float = 1.0  # caregiver uniform in [-box, box]^2, m
     # Kinematic grasp rules (docs/protocol.md §5).
     grasp_distance: float = 0.1  # m, hand to handle or toy
-    catch_distance: float = 0.1  # m, stick tip to toy
+    catch_distance: float = dataclasses.field(default=0.1, metadata={ACTS_ON: ("kinematic",)})  # m
     # "study": the stick's tip catches a toy whether or not the stick is held (arm movements),
     # and the resting hand takes a stick lying within reach during vocal movements; "held_stick":
     # only a stick in the hand catches, and nothing is grasped during vocal movements.
-    catch_rule: str = "held_stick"
+    catch_rule: str = dataclasses.field(default="held_stick", metadata={ACTS_ON: ("kinematic",)})
     # Caregiver bringing a toy (docs/protocol.md §6): fraction of the remaining way per step.
     caregiver_bring_rate: float = 0.01
     # The experimenter returns a stick beyond the hand's reach to its start pose between
@@ -92,7 +97,9 @@ class WorldConfig:
     # on physical trials (docs/protocol.md D14). None: only when no contact can take it (no
     # point of the handle geom within the arm's length plus the hand's and the handle's radii,
     # 0.546 m), the rule of every trial written before this setting.
-    stick_return_reach: float | None = dataclasses.field(default=0.53, metadata={BEFORE: None})
+    stick_return_reach: float | None = dataclasses.field(
+        default=0.53, metadata={BEFORE: None, ACTS_ON: ("physical",)}
+    )
     # The vocal tract (sim/vocal/registry.py): "vtl", VocalTractLab, this project's; or "diva",
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
     # D13). Trials written before the choice ran with VocalTractLab.
@@ -102,13 +109,17 @@ class WorldConfig:
     # damping by UNPUSHED_DAMPING_FACTOR), so that, as in the kinematic rules, only a grasp, a
     # catch or the caregiver moves an object. The kinematic backend never pushes. Older trials
     # pushed.
-    push_objects: bool = dataclasses.field(default=True, metadata={BEFORE: True})
+    push_objects: bool = dataclasses.field(
+        default=True, metadata={BEFORE: True, ACTS_ON: ("physical",)}
+    )
     # Ablation of after-effects (issue 32), never a default: True lets the physical room settle
     # between movements (SETTLE_PHYSICS_STEPS with the arm at rest), so that objects left
     # overlapping by a release, the arm's return to rest or the caregiver's putting a toy down
     # part before the next context is read, not during the next movement. Older trials did not
     # settle.
-    settle_between_movements: bool = dataclasses.field(default=False, metadata={BEFORE: False})
+    settle_between_movements: bool = dataclasses.field(
+        default=False, metadata={BEFORE: False, ACTS_ON: ("physical",)}
+    )
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a
@@ -160,6 +171,17 @@ def _check_rings(name: str, rings: Any) -> None:
             f"{name} must be {N_RINGS} [low, high] pairs of finite distances with "
             f"0 <= low < high <= {ROOM_SPAN}, got {shown}"
         )
+
+
+def inert_settings(grasp: str, changed: dict[str, Any]) -> list[str]:
+    """The names among `changed` (world settings a trial changes from its preset) that no rule
+    of the backend `grasp` reads (their field's ACTS_ON names other backends)."""
+    fields = {f.name: f for f in dataclasses.fields(WorldConfig)}
+    return [
+        name
+        for name in changed
+        if name in fields and grasp not in fields[name].metadata.get(ACTS_ON, (grasp,))
+    ]
 
 
 # The fields' defaults: the base every preset edits, equal to the "project" preset's world. A

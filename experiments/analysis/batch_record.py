@@ -15,25 +15,46 @@ from experiments.config_file import with_added_settings
 from experiments.file_names import BATCH_FILE, CONFIG_FILE, EVAL_FILE
 
 
+class RecordMismatch(ValueError):
+    """Trials of a batch directory that its record says another batch than they ran, or a
+    record that cannot be read."""
+
+
+def read_batch_record(batch_dir: str | os.PathLike) -> dict | None:
+    """A batch's record (batch.json); None for a batch written before records. RecordMismatch
+    (one line, saying what to do) for one that cannot be read or is not a record: a damaged
+    record is never taken for none, which would report the batch as another (the study's
+    reference size instead of its profile's, its trials unchecked)."""
+    path = Path(batch_dir) / BATCH_FILE
+    if not path.exists():
+        return None
+    try:
+        record = storage.read_json(path)
+    except (storage.CorruptFileError, OSError) as exc:
+        problem = " ".join(str(exc).split())
+    else:
+        if isinstance(record, dict):
+            return record
+        problem = f"{path} is not a batch record"
+    raise RecordMismatch(
+        f"{problem}: rerun `playroom batch` into {batch_dir} with the profile or config that "
+        f"made it (after removing {path.name}: the batch then checks its trials against that "
+        "run and writes the record again)"
+    )
+
+
 def recorded_reference_commands(batch_dirs: Iterable[str | os.PathLike]) -> int | None:
     """The largest study reference size (random commands per ring) the batches record, so that
     a page setting a small batch beside a large one measures both as the large one asks; None
-    where none records one (a batch written before batch.json: the study's size applies)."""
+    where none records one (a batch written before batch.json: the study's size applies).
+    RecordMismatch for a record that cannot be read."""
     sizes = []
     for batch_dir in batch_dirs:
-        path = Path(batch_dir) / BATCH_FILE
-        try:
-            record = storage.read_json(path) if path.is_file() else None
-        except (storage.CorruptFileError, OSError):
-            record = None  # a damaged record is no record: the study's size applies
+        record = read_batch_record(batch_dir)
         size = record.get("study_reference_commands") if isinstance(record, dict) else None
         if isinstance(size, int) and not isinstance(size, bool) and size > 0:
             sizes.append(size)
     return max(sizes, default=None)
-
-
-class RecordMismatch(ValueError):
-    """Trials of a batch directory that its record says another batch than they ran."""
 
 
 # The trial settings a record fixes for every trial (a record field -> config.json's "trial").
@@ -70,13 +91,11 @@ def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path])
     """RecordMismatch (one line) naming the trials of `batch_dir` whose config.json (or
     evaluation) disagrees with the batch's record (batch.json): a batch rerun into the same
     directory with other settings, before `playroom batch` refused it, left such a mix. A
-    batch without a readable record is not checked (one written before batch.json)."""
+    batch without a record is not checked (one written before batch.json); a record that
+    cannot be read is refused (`read_batch_record`)."""
     path = Path(batch_dir) / BATCH_FILE
-    try:
-        record = storage.read_json(path) if path.is_file() else None
-    except (storage.CorruptFileError, OSError):
-        record = None  # as for the reference size: a damaged record is no record
-    if not isinstance(record, dict):
+    record = read_batch_record(batch_dir)
+    if record is None:
         return
     found = []
     for trial_dir in trial_dirs:

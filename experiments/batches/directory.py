@@ -156,8 +156,14 @@ def _check_trials(spec: BatchSpec, out: Path) -> None:
 
 def check_directory(spec: BatchSpec, out: Path) -> None:
     """BatchError (one line) unless `out` is new, or holds this batch: its record and every
-    trial it holds are what `spec` would write. Reads only."""
+    trial it holds are what `spec` would write (a trial directory itself is no batch's).
+    Reads only."""
     if not out.is_dir():
         return
+    if is_trial_dir(out):
+        raise BatchError(
+            f"{out} is a trial directory (it holds {CONFIG_FILE} and log/), not a batch's: give "
+            "the batch a directory of its own"
+        )
     _check_record(spec, out)
     _check_trials(spec, out)

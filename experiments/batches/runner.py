@@ -16,6 +16,7 @@ import hashlib
 import json
 import logging
 import os
+import sys
 import threading
 import time
 import uuid
@@ -47,7 +48,7 @@ from experiments.file_names import (
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run import memory_segments, stop_requests
+from experiments.run import estimate, memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
@@ -224,6 +225,12 @@ def run_batch(
         raise BatchError(f"cannot read {out}: {storage.reason(exc)}") from None
     todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
     skipped = len(spec.trials()) - len(todo)
+    try:  # the whole batch's disk, before anything is written or a worker started
+        told = estimate.check_batch_fits(out, [(out / n, s) for n, s in todo])
+    except TrialError as exc:
+        raise BatchError(str(exc)) from None
+    if told is not None and progress:
+        print(f"batch: {told}", file=sys.stderr)
     if not todo:
         _record(spec, out)
         if progress:

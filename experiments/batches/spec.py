@@ -13,6 +13,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TypeGuard
 
+from experiments import storage
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.batches.stored import stored_profiles
 from experiments.run.settings import TrialSettings, full_config
@@ -176,8 +177,8 @@ def with_overrides(spec: BatchSpec, overrides: dict) -> BatchSpec:
 def _read_fields(text: str, source: str) -> dict:
     """The fields of a batch config's JSON text, each name known."""
     try:
-        raw = json.loads(text)
-    except json.JSONDecodeError as exc:
+        raw = storage.strict_json(text)
+    except (json.JSONDecodeError, storage.DuplicateKeyError) as exc:
         raise BatchError(f"{source} is not valid JSON ({exc})") from None
     if not isinstance(raw, dict):
         raise BatchError(f"{source} must hold a JSON object of the fields {', '.join(FIELD_RULES)}")

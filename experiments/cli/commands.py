@@ -54,7 +54,10 @@ def cmd_run(args: argparse.Namespace) -> None:
     # its own settings, which those given must match.
     given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
     if args.set:
-        given["overrides"] = merged({}, args.set)
+        try:
+            given["overrides"] = merged({}, args.set)
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
     try:
         if args.resume:
             settings = resume_settings(args.out, given)
@@ -125,7 +128,10 @@ def cmd_batch(args: argparse.Namespace) -> None:
     try:
         spec = load_spec(args.profile, args.config)
         if args.set:
-            spec = with_overrides(spec, merged(spec.overrides, args.set))
+            try:
+                spec = with_overrides(spec, merged(spec.overrides, args.set))
+            except ValueError as exc:  # a --set given twice
+                raise BatchError(str(exc)) from None
         results = run_batch(
             spec, args.out, scheduler=args.scheduler, n_workers=args.workers,
             progress=not args.quiet,
@@ -146,6 +152,8 @@ def cmd_render(args: argparse.Namespace) -> None:
         gl.for_rendering()  # before anything imports mujoco
     except gl.GLError as exc:
         raise UsageError(str(exc)) from None
+    from experiments import storage
+    from experiments.run.trial_files import TrialError
     from experiments.video.encoding import RenderError
     from experiments.video.episodes import render_random
     from experiments.video.replay import ReplayError, render_trial
@@ -167,8 +175,9 @@ def cmd_render(args: argparse.Namespace) -> None:
             args.dir, args.out, iterations=args.iterations, use_highlights=args.highlights,
             size=args.size, fps=args.fps, camera=args.camera,
         )  # fmt: skip
-    except (ValueError, RenderError, ReplayError) as exc:
-        raise UsageError(str(exc)) from None
+    except (ValueError, RenderError, ReplayError, TrialError, storage.CorruptFileError) as exc:
+        # A trial whose files are damaged, foreign or missing, or whose config makes no room.
+        raise UsageError(" ".join(str(exc).split())) from None
     for r in replayed:
         verdict = "events as logged" if r.matches else "DIFFERS from the log"
         print(f"  iteration {r.iteration}: replayed {verdict}")
@@ -309,10 +318,13 @@ def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
     builds no room), with the reference size asked for, else the one the batches record (their
     profile's), else the study's (experiments.analysis.study_summary), played on the processes
     asked for (--workers), else on every core."""
-    from experiments.analysis.batch_record import recorded_reference_commands
+    from experiments.analysis.batch_record import RecordMismatch, recorded_reference_commands
     from experiments.measure.for_reports import room_measures
 
-    n = args.study_reference_commands or recorded_reference_commands(batch_dirs)
+    try:
+        n = args.study_reference_commands or recorded_reference_commands(batch_dirs)
+    except RecordMismatch as exc:
+        raise UsageError(str(exc)) from None
     workers = getattr(args, "workers", None)  # None: the machine's cores
     if n is None:
         return {"measures": room_measures(workers=workers)}

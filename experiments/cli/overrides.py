@@ -37,9 +37,14 @@ def dotted_setting(text: str) -> tuple[str, str, Any]:
 
 
 def merged(overrides: dict, settings: list[tuple[str, str, Any]] | None) -> dict:
-    """`overrides` ({"world": {...}, "learner": {...}}) with each `--set` applied in order
-    (a later one wins); a new dict, the given one left as it is."""
+    """`overrides` ({"world": {...}, "learner": {...}}, a batch config's) with each `--set`
+    applied (over the config's own); a new dict, the given one left as it is. ValueError (one
+    line) for a setting given twice: which of the two was meant cannot be told."""
     out = copy.deepcopy(overrides)
+    given: set[tuple[str, str]] = set()
     for section, name, value in settings or []:
+        if (section, name) in given:
+            raise ValueError(f"--set {section}.{name} is given twice: give each setting once")
+        given.add((section, name))
         out.setdefault(section, {})[name] = value
     return out

@@ -116,6 +116,33 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
     )
 
 
+def check_batch_fits(out_dir: Path, trials: list[tuple[Path, TrialSettings]]) -> str | None:
+    """For a batch's trials still to run (each its directory and settings, resumed where they
+    stand): TrialError (one line) if their files together will not fit on the disk of
+    `out_dir`, before anything is written or a worker started; else the line that states a long
+    batch's costs (its trials' seconds, if one process ran them all, and disk), or None."""
+    costs, held = [], 0
+    for trial_dir, settings in trials:
+        start, on_disk = _progress(trial_dir) if trial_dir.is_dir() else (0, 0)
+        costs.append(trial_costs(settings, start))
+        held += on_disk
+    need = sum(c.disk_bytes for c in costs) - held
+    free = _free_space(_existing(out_dir))
+    if free is not None and need > free:
+        raise TrialError(
+            f"this batch's {len(trials)} trial(s) to run need ~{size(need)} more of logs and "
+            f"checkpoints on {out_dir} ({size(free)} free): ask for fewer iterations or seeds, "
+            "or another disk (the development machine's costs: docs/speed.md)"
+        )
+    seconds = sum(c.seconds for c in costs)
+    if not trials or max(s.iterations for _, s in trials) <= LONG_TRIAL:
+        return None
+    return (
+        f"this batch: {len(trials)} trial(s) to run, ~{duration(seconds)} on one core in all "
+        f"(divide by the workers), ~{size(need)} of logs and checkpoints on {out_dir}"
+    )
+
+
 _GROWTH_RATIO = SECONDS_NEAR_A_MILLION / SECONDS_NEAR_GROWTH_FROM
 # The power of the iteration the measured cost per iteration follows between the two figures.
 _GROWTH_POWER = math.log(_GROWTH_RATIO) / math.log(1e6 / GROWTH_FROM)

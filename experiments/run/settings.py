@@ -25,7 +25,7 @@ from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
 from models.checks import INT64_MAX, check_seed
 from models.presets import DEFAULT_PRESET, PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
-from sim.config import STICK_RETURNS, WorldConfig, world_preset
+from sim.config import STICK_RETURNS, WorldConfig, inert_settings, world_preset
 from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import REGISTRY
 from sim.physics import PlayroomPhysics
@@ -155,6 +155,14 @@ def full_config(
         PlayroomPhysics.load(world)
     except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
         raise TrialError(f"overrides do not fit the configs: {exc}") from None
+    # A world switch no rule of the trial's backend reads would only be recorded: refused.
+    inert = inert_settings(settings.grasp, changes.get("world", {}))
+    if inert:
+        raise TrialError(
+            f"overrides.world.{inert[0]} changes nothing on the {settings.grasp} backend (none "
+            "of its rules reads it: sim/config.py); leave it out, or run it on a backend it acts "
+            "on (a batch of several backends: one batch per backend)"
+        )
     if world.voice == "diva":
         # Its data is the user's: checked before anything is written, never replaced by VTL.
         try:

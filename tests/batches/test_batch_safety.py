@@ -244,13 +244,13 @@ def test_batch_set_merges_into_the_specs_overrides_and_is_checked(tmp_path, caps
 
     spec = BatchSpec(overrides={"learner": {"exploration_sigma": 0.05}})
     sets = [
-        dotted_setting("world.catch_rule=held_stick"),
+        dotted_setting("world.caregiver_bring_rate=0.02"),
         dotted_setting("learner.clip_sensory=false"),
     ]
     changed = with_overrides(spec, merged(spec.overrides, sets))
     assert changed.overrides == {
         "learner": {"exploration_sigma": 0.05, "clip_sensory": False},
-        "world": {"catch_rule": "held_stick"},
+        "world": {"caregiver_bring_rate": 0.02},
     }
     assert spec.overrides == {"learner": {"exploration_sigma": 0.05}}  # left as it was
     out = tmp_path / "out"

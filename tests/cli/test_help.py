@@ -101,11 +101,44 @@ def test_a_bad_dotted_setting_is_refused(text, said):
         dotted_setting(text)
 
 
-def test_later_sets_win_and_the_given_overrides_stay_as_they_were():
+def test_a_set_wins_over_the_config_and_a_setting_set_twice_is_refused():
     base = {"learner": {"exploration_sigma": 0.1}}
-    sets = [("learner", "exploration_sigma", 0.2), ("learner", "exploration_sigma", 0.3)]
-    assert merged(base, sets) == {"learner": {"exploration_sigma": 0.3}}
+    assert merged(base, [("learner", "exploration_sigma", 0.2)]) == {
+        "learner": {"exploration_sigma": 0.2}
+    }
     assert base == {"learner": {"exploration_sigma": 0.1}}
+    sets = [("learner", "exploration_sigma", 0.2), ("learner", "exploration_sigma", 0.3)]
+    with pytest.raises(ValueError, match="exploration_sigma is given twice"):
+        merged(base, sets)
+
+
+def test_a_setting_set_twice_on_the_command_line_is_one_line_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "trial"
+    twice = ["--set", "learner.exploration_sigma=0.05", "--set", "learner.exploration_sigma=0.1"]
+    assert main(["run", "--out", str(out), "--iterations", "3", "--quiet", *twice]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "given twice" in err[0] and not out.exists()
+    batch = ["batch", "--profile", "smoke", "--out", str(tmp_path / "b"), "--quiet", *twice]
+    assert main(batch) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "given twice" in err[0] and not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize(
+    "setting", ["world.push_objects=false", "world.settle_between_movements=true"]
+)
+def test_a_world_switch_the_backend_never_reads_is_refused(tmp_path, capsys, setting):
+    out = tmp_path / "trial"
+    assert main(["run", "--out", str(out), "--iterations", "3", "--quiet", "--set", setting]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "changes nothing on the kinematic backend" in err[0]
+    assert not out.exists()
+    physical = ["run", "--out", str(out), "--iterations", "3", "--quiet", "--grasp", "physical"]
+    assert main([*physical, "--set", setting]) == 0  # where it acts it is taken
+    capsys.readouterr()
+    batch = ["batch", "--profile", "smoke", "--out", str(tmp_path / "b"), "--set", setting]
+    assert main([*batch, "--quiet"]) == 2  # the smoke batch holds kinematic trials too
+    assert "one batch per backend" in capsys.readouterr().err
 
 
 def test_run_set_reaches_the_trials_config_and_is_checked(tmp_path, capsys):

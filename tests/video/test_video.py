@@ -297,3 +297,30 @@ def test_a_diva_film_sounds_through_its_tract_and_says_what_the_sound_is(
     assert "Audio:" in stream_listing(out)
     wave, _ = decoded_sound(out, tmp_path)
     assert np.abs(wave).max() > 1000  # the agent's sound or the caregiver's word is heard
+
+
+@pytest.mark.parametrize("damage", ["foreign chunk", "truncated chunk", "broken config"])
+def test_d1_render_of_a_damaged_trial_is_one_line_naming_the_file(
+    tmp_path, capsys, trained_trial, batches, damage
+):
+    import shutil
+
+    from experiments.cli.main import main
+
+    trial = tmp_path / "trial"
+    shutil.copytree(trained_trial.dir, trial)
+    chunk = trial / "log" / "iterations" / "chunk-00000000.parquet"
+    if damage == "foreign chunk":  # another trial's first chunk in its place
+        other = batches["kinematic"] / "kinematic-random-seed0000" / "log" / "iterations"
+        shutil.copy(other / "chunk-00000000.parquet", chunk)
+        named = chunk.name
+    elif damage == "truncated chunk":
+        chunk.write_bytes(chunk.read_bytes()[:500])
+        named = chunk.name
+    else:
+        (trial / "config.json").write_text('{"trial": ')
+        named = "config.json"
+    code = main(["render", str(trial), "--out", str(tmp_path / "a.mp4"), "--iterations", "5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and named in err[0], err
+    assert not (tmp_path / "a.mp4").exists()
