@@ -9,6 +9,9 @@ per trial, and the pages written about it.
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 # The trial itself -----------------------------------------------------------------------
 CONFIG_FILE = "config.json"
 CHECKPOINT_FILE = "checkpoint.npz"
@@ -67,6 +70,9 @@ COMPETENCE_FILE = "competence.parquet"
 VOCAL_FILE = "vocal.parquet"
 # The tests of the study's own measure (experiments/measure/study_measure.py).
 STUDY_TESTS_FILE = "study-tests.parquet"
+# A trial's final agent tested in another world (experiments/measure/cross_evaluation.py):
+# `eval-in-WORLD/` beside the trial's own evaluation, holding the same four files.
+CROSS_EVALUATION_PREFIX = "eval-in-"
 # The tables an evaluation writes beside eval.json, which lists them with their checksums.
 EVALUATION_TABLES = (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
 # Seconds and iterations of the batch task that last ran the trial.
@@ -101,3 +107,8 @@ def memory_segment_name(start: int) -> str:
 def manifest_name(iteration: int) -> str:
     """The name of the manifest file the checkpoint at `iteration` names, in MANIFEST_DIR."""
     return f"files-{iteration:08d}.json"
+
+
+def cross_evaluation_dir(trial_dir: str | os.PathLike, world: str) -> Path:
+    """Where a trial's test in `world` is written."""
+    return Path(trial_dir) / f"{CROSS_EVALUATION_PREFIX}{world}"

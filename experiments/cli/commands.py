@@ -83,24 +83,29 @@ def cmd_run(args: argparse.Namespace) -> None:
 def cmd_eval(args: argparse.Namespace) -> None:
     """Competence, strategies and vocal accuracy of a trial's final state."""
     from experiments import storage
+    from experiments.measure.cross_evaluation import evaluate_in_world
     from experiments.measure.evaluation import EvaluationSettings
     from experiments.measure.trial_evaluation import evaluate_trial
     from experiments.provenance import computed_on_line
     from experiments.run.trial_files import TrialError
 
+    settings = EvaluationSettings(n_placements=args.placements)
+    notify = lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True)  # noqa: E731
     try:
-        summary = evaluate_trial(
-            args.dir,
-            EvaluationSettings(n_placements=args.placements),
-            progress=not args.quiet,
-            notify=lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True),
-        )
+        if args.world == "own":
+            summary = evaluate_trial(args.dir, settings, progress=not args.quiet, notify=notify)
+        else:
+            summary = evaluate_in_world(
+                args.dir, args.world, settings, progress=not args.quiet, notify=notify
+            )
     except (TrialError, storage.CorruptFileError) as exc:
         raise UsageError(str(exc)) from None
     c, v = summary["competence"], summary["vocal"]
+    tested = summary.get("test_world")
+    where = "" if tested is None else f", tested in the {tested['name']} world"
     print(
         f"{args.dir}: {summary['grasp']}, seed {summary['seed']}, "
-        f"{summary['evaluated_at_iteration']} iterations"
+        f"{summary['evaluated_at_iteration']} iterations{where}"
     )
     print(f"  {computed_on_line(args.dir)}")
     print(

@@ -152,6 +152,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--placements", type=positive_int, default=100, help="toy placements tested per ring"
     )
+    p.add_argument(
+        "--world",
+        choices=("own", *GRASPS),
+        default="own",
+        help="the world the final agent is tested in: its own (eval.json beside the trial), or "
+        "another backend's with its rules as the trial's preset sets them, written into "
+        "DIR/eval-in-WORLD/ (docs/protocol.md D26); default: own",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_eval)
 

@@ -1,0 +1,85 @@
+"""Agents tested in the worlds they did not learn in (issue 40), read back as one table: for
+every trial of some batches and every test world, the trial's numbers as that world tested its
+final agent, so that a difference between two conditions splits into what the agents learned
+(the same test world, agents of both) and what the test world does (the same agents, both
+worlds).
+
+A trial's test in a world is its cross-evaluation (`DIR/eval-in-WORLD/eval.json`,
+experiments/measure/cross_evaluation.py) or, where the trial learned in that very world (its
+config equals the world's, `config_file.config_tested_in`), its own evaluation (eval.json).
+Each evaluation's tables are checked against the sizes and SHA-256 its eval.json lists.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from experiments import manifest, storage
+from experiments.analysis.logs import trial_dirs
+from experiments.config_file import config_tested_in, with_added_settings
+from experiments.file_names import (
+    CONFIG_FILE,
+    EVAL_FILE,
+    EVALUATION_TABLES,
+    cross_evaluation_dir,
+)
+
+RINGS = ("ring1", "ring2", "ring3")
+STRATEGIES = ("hand", "tool", "vocal")
+
+
+class MissingTestError(ValueError):
+    """A trial that was not tested in a world asked for; one line names it and the command."""
+
+
+def tested_in(trial_dir: Path, world: str) -> tuple[dict, str]:
+    """(eval.json's numbers, which evaluation: "own" or "cross") of a trial tested in `world`.
+    MissingTestError where it was not; storage.CorruptFileError for an evaluation whose tables
+    are not as its eval.json lists them."""
+    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+    cross = cross_evaluation_dir(trial_dir, world)
+    if (cross / EVAL_FILE).exists():
+        folder, which = cross, "cross"
+    elif config_tested_in(config, world) == config:
+        folder, which = trial_dir, "own"
+    else:
+        raise MissingTestError(
+            f"{trial_dir.name} was not tested in the {world} world: "
+            f"`playroom eval {trial_dir} --world {world}`"
+        )
+    if not (folder / EVAL_FILE).exists():
+        raise MissingTestError(f"{trial_dir.name} is not evaluated: `playroom eval {trial_dir}`")
+    summary = storage.read_json(folder / EVAL_FILE)
+    for name in EVALUATION_TABLES:
+        manifest.read_evaluation_file(folder, name, summary)
+    return summary, which
+
+
+def cross_table(batches: dict[str, str | os.PathLike], worlds: tuple[str, ...]) -> pd.DataFrame:
+    """One row per (condition, trial, test world): `condition` (the key of `batches`, a batch
+    directory each), seed, the trial's backend, `world`, `evaluation` (own or cross), the
+    project's normalised competence (all, ring1-3) and each ring's strategy shares. Every trial
+    of every batch must have been tested in every world (MissingTestError otherwise)."""
+    rows = []
+    for condition, batch_dir in batches.items():
+        for trial_dir in trial_dirs(batch_dir):
+            for world in worlds:
+                summary, which = tested_in(trial_dir, world)
+                row = {
+                    "condition": condition,
+                    "trial": trial_dir.name,
+                    "seed": summary["seed"],
+                    "grasp": summary["grasp"],
+                    "world": world,
+                    "evaluation": which,
+                    **{f"competence_{k}": v for k, v in summary["competence"].items()},
+                }
+                for ring in RINGS:
+                    shares = summary["strategy_share"].get(ring, {})
+                    for strategy in STRATEGIES:
+                        row[f"{strategy}_{ring}"] = float(shares.get(strategy, 0.0))
+                rows.append(row)
+    return pd.DataFrame(rows)
