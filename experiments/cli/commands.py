@@ -332,8 +332,8 @@ def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
         raise UsageError(str(exc)) from None
     workers = getattr(args, "workers", None)  # None: the machine's cores
     if n is None:
-        return {"measures": room_measures(workers=workers)}
-    return {"measures": room_measures(n, workers=workers)}
+        return {"measures": room_measures(workers=workers, batch_dirs=batch_dirs)}
+    return {"measures": room_measures(n, workers=workers, batch_dirs=batch_dirs)}
 
 
 def cmd_voice_data(args: argparse.Namespace) -> None:
