@@ -71,6 +71,10 @@ STUDY_TESTS_FILE = "study-tests.parquet"
 EVALUATION_TABLES = (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
 # Seconds and iterations of the batch task that last ran the trial.
 TIMING_FILE = "timing.json"
+# The trial's final agent evaluated in another world than its own (experiments/eval_worlds.py):
+# eval-in-NAME/, holding an evaluation's eval.json and EVALUATION_TABLES. Derived like the rest:
+# moved aside with them when the trial is extended.
+EVAL_WORLD_PREFIX = "eval-in-"
 
 # What a batch is: its spec as `playroom batch` last ran it (experiments/batches/spec.py).
 BATCH_FILE = "batch.json"
@@ -85,6 +89,11 @@ ABLATION_FIGURE_FILE = "ablations.png"
 # (experiments/report/summary.py): nested JSON, and the same numbers as one long CSV table.
 SUMMARY_JSON_FILE = "summary.json"
 SUMMARY_CSV_FILE = "summary.csv"
+
+
+def eval_world_dir(world: str) -> str:
+    """The folder of a trial directory that holds its evaluation in eval world `world`."""
+    return f"{EVAL_WORLD_PREFIX}{world}"
 
 
 def log_chunk_name(start: int) -> str:
