@@ -22,8 +22,8 @@ from experiments.eval_worlds import (
     SWITCHES,
     EvalWorld,
     own_world,
-    world_settings,
     world_record,
+    world_settings,
 )
 from experiments.file_names import (
     COMPETENCE_FILE,
