@@ -5,23 +5,32 @@
   hand did not hold it) to what touched it: the hand, a toy the hand holds, a free toy.
 - `grasp_rates`: the share of random arm commands that grasp the stick from its start pose, in
   each backend asked (every registered one by default), for the very same commands: how much
-  harder contact grasping is than the study's distance rule.
+  harder contact grasping is than the study's distance rule. Each backend plays in the world
+  its trials ran in (`batch_worlds`: their config.json's), whose DMP turns the commands into
+  movements: the project's DMP and the study's grasp different shares of the same commands.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 
+from experiments import storage
+from experiments.config_file import with_added_settings
+from experiments.file_names import CONFIG_FILE
+from experiments.log_layout import is_trial_dir
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import fresh_trial_parts
 from models.layout import ARM_DIM, TOYS
+from models.presets import DEFAULT_PRESET
 from sim import Playroom
 from sim import events as ev
-from sim.config import DEFAULT_WORLD
+from sim.config import WorldConfig, config_from_dict, world_preset
 from sim.grasping.names import GRASPS
 
 # What can touch the stick, as push_sources names it.
@@ -77,16 +86,39 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
     }
 
 
+def batch_worlds(batch_dirs: Iterable[str | os.PathLike]) -> dict[str, dict]:
+    """Grasp backend -> the world (config.json's "world", added settings filled in) of the
+    first trial of the first batch directory given that ran it: the world `grasp_rates` plays
+    that backend in. Trials whose config cannot be read are passed over (a report's reading
+    of the batch names them)."""
+    worlds: dict[str, dict] = {}
+    for batch_dir in map(Path, batch_dirs):
+        trials = (
+            sorted(d for d in batch_dir.iterdir() if is_trial_dir(d)) if batch_dir.is_dir() else []
+        )
+        for trial_dir in trials:
+            try:
+                config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+                worlds.setdefault(config["trial"]["grasp"], config["world"])
+            except (OSError, storage.CorruptFileError, KeyError, TypeError, AttributeError):
+                continue
+    return worlds
+
+
 def grasp_rates(
     n_commands: int = 1000,
     grasps: Sequence[str] = GRASPS,
     seed: int = 0,
     progress: bool | None = None,
+    worlds: Mapping[str, dict] | None = None,
 ) -> dict[str, float]:
     """Share of random arm commands that grasp the stick, per backend of `grasps`, each
     command from the same scene: the stick at its start pose, the toys where the room's seed
-    placed them. A backend's share does not depend on which others are measured beside it.
-    progress: a bar on stderr (None: only on a terminal)."""
+    placed them. Each backend plays in the world `worlds` gives it (config.json's "world" of
+    the trials that ran it: `batch_worlds`), else in the default preset's (what `Playroom()`
+    builds), with the experimenter's stick return off. A backend's share does not depend on
+    which others are measured beside it. progress: a bar on stderr (None: only on a
+    terminal)."""
     from tqdm import tqdm
 
     bar = tqdm(
@@ -97,10 +129,14 @@ def grasp_rates(
     )
     rng = np.random.default_rng(seed)
     commands = rng.uniform(-1.0, 1.0, (n_commands, ARM_DIM))
-    start = (*DEFAULT_WORLD.stick_start_handle, DEFAULT_WORLD.stick_start_angle)
     rates = {}
     for grasp in grasps:
-        config = dataclasses.replace(DEFAULT_WORLD, stick_return="never")
+        given = (worlds or {}).get(grasp)
+        world = (
+            world_preset(DEFAULT_PRESET) if given is None else config_from_dict(WorldConfig, given)
+        )
+        config = dataclasses.replace(world, stick_return="never")
+        start = (*config.stick_start_handle, config.stick_start_angle)
         room = Playroom(grasp, seed=seed, config=config)
         toys = room.context()[2:8].reshape(3, 2)
         grasped = 0
