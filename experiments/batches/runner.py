@@ -228,7 +228,8 @@ def _run_and_evaluate(
         for world in eval_worlds:
             if not eval_world_complete(path, world, eval_placements):
                 tested[world] = evaluate_trial(path, evaluation, world=world)["competence"]
-        summary["eval_worlds"] = tested  # the competences of the evaluations made now
+        if eval_worlds:  # the competences of the evaluations made now
+            summary["eval_worlds"] = tested
         summary["wall_seconds"] = time.perf_counter() - start
     finally:
         lock.release()
