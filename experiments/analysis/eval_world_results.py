@@ -22,7 +22,14 @@ from experiments import manifest, storage
 from experiments.analysis.results import BatchResults, ReportError
 from experiments.analysis.results import collect as collect_own
 from experiments.config_file import with_added_settings
-from experiments.eval_worlds import EVAL_WORLDS, OWN, EvalWorldError, own_world, world_record
+from experiments.eval_worlds import (
+    EVAL_WORLDS,
+    OWN,
+    SWITCHES,
+    EvalWorldError,
+    own_world,
+    world_record,
+)
 from experiments.file_names import CONFIG_FILE, EVAL_FILE, EVALUATION_TABLES, eval_world_dir
 from experiments.log_layout import is_trial_dir
 
@@ -55,8 +62,11 @@ def check_evaluation(trial_dir: Path, config: dict, world: str, summary: dict) -
     an evaluation, each as it lies there (size and SHA-256)."""
     folder = Path(trial_dir) / eval_world_dir(world)
     how = remedy(trial_dir, world)
-    expected = json.loads(json.dumps(world_record(config, world)))
-    if summary.get("eval_world") != expected:
+    # What makes the world: a world setting added to the project later (and filled in for
+    # older files, experiments/config_file.py) does not make an evaluation stale.
+    expected = json.loads(json.dumps(_identity(world_record(config, world))))
+    recorded = summary.get("eval_world")
+    if not isinstance(recorded, dict) or _identity(recorded) != expected:
         raise EvalWorldMismatch(
             f"{folder / EVAL_FILE} is not an evaluation in the {world} world as declared now "
             f"(experiments/eval_worlds.py): {how}"
@@ -71,6 +81,13 @@ def check_evaluation(trial_dir: Path, config: dict, world: str, summary: dict) -
                 f"{folder / EVAL_FILE} does not list {name}: {how}"
             ) from None
         recorded.read_bytes(folder / name, how)
+
+
+def _identity(record: dict) -> dict:
+    """What makes an eval world of a world record: its name, backend and switches."""
+    world = record.get("world")
+    switches = {s: world.get(s) for s in SWITCHES} if isinstance(world, dict) else None
+    return {"name": record.get("name"), "grasp": record.get("grasp"), "switches": switches}
 
 
 def _config(trial_dir: Path) -> dict:

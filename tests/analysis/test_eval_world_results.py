@@ -87,3 +87,12 @@ def test_a_damaged_or_foreign_evaluation_is_refused_in_one_line(batch, tmp_path,
 def test_an_unknown_world_is_refused():
     with pytest.raises(ReportError, match="unknown eval world 'magnetic'"):
         collect(".", "magnetic")
+
+
+def test_a_world_setting_added_since_does_not_make_an_evaluation_stale(batch, tmp_path):
+    copy = shutil.copytree(batch, tmp_path / "batch")
+    path = copy / "kinematic-random-seed0000" / eval_world_dir("physical") / EVAL_FILE
+    summary = storage.read_json(path)
+    del summary["eval_world"]["world"]["stick_return_reach"]  # as if written before it existed
+    storage.write_json(path, summary)
+    assert len(collect(copy, "physical").trials) == 2
