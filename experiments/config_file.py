@@ -11,8 +11,7 @@ own. Adding a world setting is its field with its `before`; nothing here changes
 The trial's own settings (experiments/run/settings.py) lie above this module, in the stage that
 runs trials, which the readers of trials may not import; the only ones added since are choices
 of a world setting of their name (WORLD_CHOICES), which share its history.
-A trial's config as another backend's world tests it (`config_tested_in`, issue 40) is
-derived here too, from the same declarations. Pure functions of dicts, and the configs' plain
+Pure functions of dicts, and the configs' plain
 dataclasses (no simulator): every reader of config.json can use them.
 """
 
@@ -21,7 +20,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-from sim.config import ACTS_ON, BEFORE, WorldConfig, world_preset
+from sim.config import BEFORE, WorldConfig
 from sim.vocal.config import VoiceConfig
 
 # The sections of config.json whose settings declare their earlier values beside their fields.
@@ -74,18 +73,3 @@ def _section(config: dict, key: str) -> tuple[dict | None, str]:
     for parent in parents:
         node = node.get(parent) if isinstance(node, dict) else None
     return (node if isinstance(node, dict) else None), last
-
-
-def config_tested_in(config: dict, grasp: str) -> dict:
-    """A trial's config as the world of the backend `grasp` tests its final agent (issue 40,
-    experiments/measure/cross_evaluation.py): `trial.grasp` replaced and every backend switch
-    (a world field that declares the backends it acts on, ACTS_ON) at the trial's preset's
-    value; every other setting the trial's own. A copy; the name is not checked here."""
-    preset = world_preset(config["trial"]["preset"])
-    tested = copy.deepcopy(config)
-    tested["trial"]["grasp"] = grasp
-    for field in dataclasses.fields(WorldConfig):
-        if ACTS_ON in field.metadata:  # a backend's rule: the preset's, in every test world
-            value = getattr(preset, field.name)
-            tested["world"][field.name] = list(value) if isinstance(value, tuple) else value
-    return tested

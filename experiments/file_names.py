@@ -9,9 +9,6 @@ per trial, and the pages written about it.
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 # The trial itself -----------------------------------------------------------------------
 CONFIG_FILE = "config.json"
 CHECKPOINT_FILE = "checkpoint.npz"
@@ -70,13 +67,14 @@ COMPETENCE_FILE = "competence.parquet"
 VOCAL_FILE = "vocal.parquet"
 # The tests of the study's own measure (experiments/measure/study_measure.py).
 STUDY_TESTS_FILE = "study-tests.parquet"
-# A trial's final agent tested in another world (experiments/measure/cross_evaluation.py):
-# `eval-in-WORLD/` beside the trial's own evaluation, holding the same four files.
-CROSS_EVALUATION_PREFIX = "eval-in-"
 # The tables an evaluation writes beside eval.json, which lists them with their checksums.
 EVALUATION_TABLES = (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
 # Seconds and iterations of the batch task that last ran the trial.
 TIMING_FILE = "timing.json"
+# The trial's final agent evaluated in another world than its own (experiments/eval_worlds.py):
+# eval-in-NAME/, holding an evaluation's eval.json and EVALUATION_TABLES. Derived like the rest:
+# moved aside with them when the trial is extended.
+EVAL_WORLD_PREFIX = "eval-in-"
 
 # What a batch is: its spec as `playroom batch` last ran it (experiments/batches/spec.py).
 BATCH_FILE = "batch.json"
@@ -93,6 +91,11 @@ SUMMARY_JSON_FILE = "summary.json"
 SUMMARY_CSV_FILE = "summary.csv"
 
 
+def eval_world_dir(world: str) -> str:
+    """The folder of a trial directory that holds its evaluation in eval world `world`."""
+    return f"{EVAL_WORLD_PREFIX}{world}"
+
+
 def log_chunk_name(start: int) -> str:
     """The name of the log chunk that starts at iteration `start`, in its kind's folder."""
     return f"{LOG_CHUNK_PREFIX}{start:08d}.parquet"
@@ -107,8 +110,3 @@ def memory_segment_name(start: int) -> str:
 def manifest_name(iteration: int) -> str:
     """The name of the manifest file the checkpoint at `iteration` names, in MANIFEST_DIR."""
     return f"files-{iteration:08d}.json"
-
-
-def cross_evaluation_dir(trial_dir: str | os.PathLike, world: str) -> Path:
-    """Where a trial's test in `world` is written."""
-    return Path(trial_dir) / f"{CROSS_EVALUATION_PREFIX}{world}"

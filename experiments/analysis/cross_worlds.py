@@ -4,9 +4,9 @@ final agent, so that a difference between two conditions splits into what the ag
 (the same test world, agents of both) and what the test world does (the same agents, both
 worlds).
 
-A trial's test in a world is its cross-evaluation (`DIR/eval-in-WORLD/eval.json`,
-experiments/measure/cross_evaluation.py) or, where the trial learned in that very world (its
-config equals the world's, `config_file.config_tested_in`), its own evaluation (eval.json).
+A trial's test in a world is its evaluation in that eval world (`DIR/eval-in-WORLD/eval.json`,
+`playroom eval DIR --world WORLD`, experiments/eval_worlds.py) or, where that world is the
+trial's own (`eval_worlds.own_world`), its own evaluation (eval.json).
 Each evaluation's tables are checked against the sizes and SHA-256 its eval.json lists.
 """
 
@@ -19,12 +19,13 @@ import pandas as pd
 
 from experiments import manifest, storage
 from experiments.analysis.logs import trial_dirs
-from experiments.config_file import config_tested_in, with_added_settings
+from experiments.config_file import with_added_settings
+from experiments.eval_worlds import own_world
 from experiments.file_names import (
     CONFIG_FILE,
     EVAL_FILE,
     EVALUATION_TABLES,
-    cross_evaluation_dir,
+    eval_world_dir,
 )
 
 RINGS = ("ring1", "ring2", "ring3")
@@ -41,10 +42,10 @@ def tested_in(trial_dir: Path, world: str, check: bool = True) -> tuple[dict, st
     are not as its eval.json lists them (unless not `check`: evaluations copied without their
     tables, whose eval.json alone is read)."""
     config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
-    cross = cross_evaluation_dir(trial_dir, world)
+    cross = trial_dir / eval_world_dir(world)
     if (cross / EVAL_FILE).exists():
         folder, which = cross, "cross"
-    elif config_tested_in(config, world) == config:
+    elif own_world(config, world):
         folder, which = trial_dir, "own"
     else:
         raise MissingTestError(

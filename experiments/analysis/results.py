@@ -15,6 +15,7 @@ import dataclasses
 import math
 import os
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -162,7 +163,7 @@ def _names(paths: list[Path], limit: int = 5) -> str:
     return shown + (f" and {len(paths) - limit} more" if len(paths) > limit else "")
 
 
-def _trial_dirs(batch_dir: Path) -> list[Path]:
+def _trial_dirs(batch_dir: Path, eval_dir: Callable[[Path], Path]) -> list[Path]:
     if not batch_dir.is_dir():
         raise ReportError(f"{batch_dir} is not a directory")
     if is_trial_dir(batch_dir):
@@ -176,7 +177,7 @@ def _trial_dirs(batch_dir: Path) -> list[Path]:
             f"no trial directories found in {batch_dir}: a batch directory holds one folder per "
             f"trial (its {CONFIG_FILE} and {LOG_DIR}/), as `playroom batch --out DIR` writes them"
         )
-    missing = [d for d in dirs if not (d / EVAL_FILE).exists()]
+    missing = [d for d in dirs if not (eval_dir(d) / EVAL_FILE).exists()]
     if missing:
         raise ReportError(
             f"{len(missing)} of {len(dirs)} trials in {batch_dir} have no {EVAL_FILE} "
@@ -286,13 +287,13 @@ def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]
 
 
 def _trial_rows(
-    d: Path, config: dict, summary: dict, label: str
+    d: Path, config: dict, summary: dict, label: str, evaluated: Path
 ) -> tuple[dict[str, Any], pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
     """(trials row, competence rows, vocal rows, curve rows, the study's test rows or None) of
-    one trial directory."""
+    one trial directory, whose evaluation lies in `evaluated`."""
     keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
-    comp = _evaluation_table(d / COMPETENCE_FILE, summary).assign(**keys)
-    voc = _evaluation_table(d / VOCAL_FILE, summary).assign(**keys)
+    comp = _evaluation_table(evaluated / COMPETENCE_FILE, summary).assign(**keys)
+    voc = _evaluation_table(evaluated / VOCAL_FILE, summary).assign(**keys)
     log, words = _read_logs(d)
     reach = backend_record.study_reach(config["world"])  # one yardstick for every backend
     names = set(voc.loc[voc["is_name"], "word"])
@@ -313,7 +314,7 @@ def _trial_rows(
         "seconds": seconds,
         "timed_iterations": timed,
     }
-    study = _read_table(d / STUDY_TESTS_FILE, summary)  # none: evaluated before it existed
+    study = _read_table(evaluated / STUDY_TESTS_FILE, summary)  # none: evaluated before it
     study = None if study is None else study.assign(**keys)
     return row, comp, voc, curve, study
 
@@ -331,18 +332,20 @@ def _warn_once_for_unchecked(
         manifest.warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
 
 
-def collect(batch_dir: str | os.PathLike) -> BatchResults:
+def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Path) -> BatchResults:
     """Read every trial of a batch directory into tables. ReportError (one line) for a
-    directory without trials, trials not evaluated, or mismatched configs within a group."""
+    directory without trials, trials not evaluated, or mismatched configs within a group.
+    `eval_dir`: the folder of a trial's evaluation read (default: the trial directory; another
+    world's: experiments/analysis/eval_world_results.py)."""
     batch_dir = Path(batch_dir)
-    dirs = _trial_dirs(batch_dir)
+    dirs = _trial_dirs(batch_dir, eval_dir)
     try:  # trials of another batch than batch.json records: never drawn under its name
         check_trials_agree(batch_dir, dirs)
     except RecordMismatch as exc:
         raise ReportError(str(exc)) from None
     configs = [_read_json(d / CONFIG_FILE) for d in dirs]
     configs = [with_added_settings(c) if isinstance(c, dict) else c for c in configs]
-    evals = [_read_json(d / EVAL_FILE) for d in dirs]
+    evals = [_read_json(eval_dir(d) / EVAL_FILE) for d in dirs]
     for d, config in zip(dirs, configs, strict=True):
         if not isinstance(config, dict) or not {"grasp", "babbling", "seed", "iterations"} <= set(
             config.get("trial", {})
@@ -368,7 +371,7 @@ def collect(batch_dir: str | os.PathLike) -> BatchResults:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", manifest.UncheckedTrialWarning)
         rows = [
-            _trial_rows(d, config, summary, label)
+            _trial_rows(d, config, summary, label, eval_dir(d))
             for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
         ]
     _warn_once_for_unchecked(batch_dir, dirs, caught)

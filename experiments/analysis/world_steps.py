@@ -3,7 +3,7 @@ ablation), split into what the agents learned and what the test world does, with
 trials paired by seed.
 
 For conditions A and B (batch directories of the same seeds), from their own evaluations and
-their cross-evaluations (experiments/measure/cross_evaluation.py):
+their evaluations in other eval worlds (`playroom eval DIR --world`, eval_worlds.py):
 - the whole step: B's agents in B's own world against A's in A's own (what the comparison
   reports);
 - what the agents learned: B's agents against A's, both tested in the same world (each test

@@ -22,8 +22,9 @@ from experiments.run.settings import full_config
 
 # Fields compared as sets: their order changes only the order trials are listed in.
 _SETS = ("grasps", "babbling", "seeds")
-# Not a setting: a rerun may describe the batch in other words.
-_FREE = ("description",)
+# Not a setting: a rerun may describe the batch in other words, and ask for other eval worlds
+# (the trials stay what they are; each world's evaluation is derived from them, beside them).
+_FREE = ("description", "eval_worlds")
 # Config keys a trial may hold otherwise and still be the batch's: the release that wrote it
 # (a checkpoint's identity leaves it out too: experiments/run/trial_files.py).
 _NOT_SETTINGS = ("package_version",)

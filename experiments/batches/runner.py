@@ -3,8 +3,11 @@
 Without a scheduler address the batch runs on a `LocalCluster` of worker processes on this
 machine; with one (`tcp://HOST:PORT`) the same batch runs on an existing cluster, e.g. workers
 started on PBS or SLURM nodes by dask-jobqueue (README). Each trial is one Dask task that runs
-(or resumes) the trial and evaluates it, so:
+(or resumes) the trial and evaluates it, in its own world and in the batch's eval worlds
+(experiments/eval_worlds.py), so:
 - rerunning a batch skips evaluated trials and resumes unfinished ones from their checkpoints;
+  a trial whose evaluations in the eval worlds are not all complete and intact has only those
+  made;
 - a worker that dies mid-trial has its task rescheduled by Dask on another worker, where it
   resumes from the trial's last checkpoint: nothing is lost beyond that, nothing duplicated.
 """
@@ -27,6 +30,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from experiments import manifest, storage
+from experiments.analysis.eval_world_results import check_evaluation
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches.directory import check_directory
 from experiments.batches.progress import (
@@ -37,6 +41,8 @@ from experiments.batches.progress import (
     reporter,
 )
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
+from experiments.config_file import with_added_settings
+from experiments.eval_worlds import EvalWorldError, own_world
 from experiments.file_names import (
     BACKEND_FILE,
     BATCH_FILE,
@@ -45,6 +51,7 @@ from experiments.file_names import (
     EVAL_FILE,
     EVALUATION_TABLES,
     TIMING_FILE,
+    eval_world_dir,
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
@@ -114,6 +121,27 @@ def is_complete(trial_dir: Path) -> bool:
     return True
 
 
+def eval_world_complete(trial_dir: Path, world: str, placements: int) -> bool:
+    """Whether a finished trial's evaluation in eval world `world` needs no work: the world is
+    the trial's own (its own evaluation is it: `is_complete`), or `eval-in-<world>/` holds an
+    evaluation at the trial's last checkpoint, on `placements` placements, of the world as
+    declared now, every table as its eval.json lists it."""
+    try:
+        config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+        if own_world(config, world):
+            return True
+        summary = storage.read_json(trial_dir / eval_world_dir(world) / EVAL_FILE)
+        meta = storage.read_meta(trial_dir / CHECKPOINT_FILE)
+        if not isinstance(summary, dict) or summary.get("n_placements") != placements:
+            return False
+        if summary.get("evaluated_at_iteration") != meta["iteration"]:
+            return False
+        check_evaluation(trial_dir, config, world, summary)
+    except (OSError, KeyError, TypeError, storage.CorruptFileError, EvalWorldError):
+        return False
+    return True
+
+
 def run_and_evaluate(
     trial_dir: str,
     settings: TrialSettings,
@@ -122,19 +150,31 @@ def run_and_evaluate(
     progress_topic: str | None = None,
     report_every: int = REPORT_EVERY,
     report_interval_s: float = REPORT_INTERVAL_S,
+    eval_worlds: tuple[str, ...] = (),
 ) -> dict | TrialFailed:
-    """One batch task: run or resume the trial, then evaluate it; its evaluation summary, or
-    `TrialFailed` for a failure a retry would repeat (DETERMINISTIC). Safe to run again. A wait
-    for another writer of the trial is told to the client listening on `topic`, the iteration
-    the trial reached (looked at every `report_every`, told at most every
-    `report_interval_s`) to the one listening on `progress_topic`."""
+    """One batch task: run or resume the trial, then evaluate it, in its own world and in
+    each of `eval_worlds`; its evaluation summary, or `TrialFailed` for a failure a retry would
+    repeat (DETERMINISTIC). Safe to run again: a trial complete and evaluated on
+    `eval_placements` is neither run nor evaluated again, nor is an evaluation in an eval world
+    that is complete and intact. A wait for another writer of the trial is told to the client
+    listening on `topic`, the iteration the trial reached (looked at every `report_every`, told
+    at most every `report_interval_s`) to the one listening on `progress_topic`."""
     try:
         return _run_and_evaluate(
             Path(trial_dir), settings, eval_placements, topic, progress_topic, report_every,
-            report_interval_s,
+            report_interval_s, eval_worlds,
         )  # fmt: skip
     except DETERMINISTIC as exc:
         return TrialFailed(f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+
+
+def _own_part_complete(path: Path, placements: int) -> dict | None:
+    """The evaluation summary of a trial that is complete (`is_complete`) and was evaluated on
+    `placements` placements, else None."""
+    if not is_complete(path):
+        return None
+    summary = storage.read_json(path / EVAL_FILE)
+    return summary if summary.get("n_placements") == placements else None
 
 
 def _run_and_evaluate(
@@ -145,6 +185,7 @@ def _run_and_evaluate(
     progress_topic: str | None,
     report_every: int,
     report_interval_s: float,
+    eval_worlds: tuple[str, ...] = (),
 ) -> dict:
     # A worker stopped mid-trial (a batch ended by Ctrl-C) must leave no multiprocessing
     # semaphore behind, which tqdm's default lock is: the resource tracker would complain after
@@ -163,23 +204,33 @@ def _run_and_evaluate(
         )
         lock = DirectoryLock(path).acquire(wait_s=LOCK_WAIT_S)
     try:
-        resume = (path / "config.json").exists()
         start = time.perf_counter()
-        trial = run_trial(
-            path, settings, resume=resume, progress=False,
-            report=reporter(progress_topic, path.name, report_interval_s),
-            report_every=report_every,
-        )  # fmt: skip
-        if trial.elapsed is not None:
-            # Only the iterations run now are timed, so resumed trials still give a fair cost.
-            storage.write_json(
-                path / TIMING_FILE,
-                {
-                    "seconds": trial.elapsed,
-                    "iterations": settings.iterations - trial.start_iteration,
-                },
-            )
-        summary = evaluate_trial(path, EvaluationSettings(n_placements=eval_placements))
+        evaluation = EvaluationSettings(n_placements=eval_placements)
+        # A rerun that only asks for eval worlds: the trial and its own evaluation are kept.
+        summary = _own_part_complete(path, eval_placements)
+        if summary is None:
+            resume = (path / "config.json").exists()
+            trial = run_trial(
+                path, settings, resume=resume, progress=False,
+                report=reporter(progress_topic, path.name, report_interval_s),
+                report_every=report_every,
+            )  # fmt: skip
+            if trial.elapsed is not None:
+                # Only the iterations run now are timed: resumed trials still give a fair cost.
+                storage.write_json(
+                    path / TIMING_FILE,
+                    {
+                        "seconds": trial.elapsed,
+                        "iterations": settings.iterations - trial.start_iteration,
+                    },
+                )
+            summary = evaluate_trial(path, evaluation)
+        tested = {}
+        for world in eval_worlds:
+            if not eval_world_complete(path, world, eval_placements):
+                tested[world] = evaluate_trial(path, evaluation, world=world)["competence"]
+        if eval_worlds:  # the competences of the evaluations made now
+            summary["eval_worlds"] = tested
         summary["wall_seconds"] = time.perf_counter() - start
     finally:
         lock.release()
@@ -223,7 +274,12 @@ def run_batch(
         check_directory(spec, out)  # one batch per directory, refused before anything is written
     except OSError as exc:
         raise BatchError(f"cannot read {out}: {storage.reason(exc)}") from None
-    todo = [(n, s) for n, s in spec.trials() if not is_complete(out / n)]
+    todo = [
+        (n, s)
+        for n, s in spec.trials()
+        if not is_complete(out / n)
+        or not all(eval_world_complete(out / n, w, spec.eval_placements) for w in spec.eval_worlds)
+    ]
     skipped = len(spec.trials()) - len(todo)
     try:  # the whole batch's disk, before anything is written or a worker started
         told = estimate.check_batch_fits(out, [(out / n, s) for n, s in todo])
@@ -270,8 +326,8 @@ def run_batch(
             key = task_key(name, trial_dir, settings, spec.eval_placements, run)
             future = client.submit(
                 run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
-                progress_topic, report_every, report_interval_s, key=key, pure=False,
-                retries=RETRIES,
+                progress_topic, report_every, report_interval_s, spec.eval_worlds, key=key,
+                pure=False, retries=RETRIES,
             )  # fmt: skip
             futures[future] = name
         if skipped and progress:

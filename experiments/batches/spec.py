@@ -16,6 +16,7 @@ from typing import TypeGuard
 from experiments import storage
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.batches.stored import stored_profiles
+from experiments.eval_worlds import EVAL_WORLDS
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig
@@ -48,6 +49,10 @@ FIELD_RULES = {
     "iterations": "a positive integer",
     "checkpoint_every": "a positive integer",
     "eval_placements": "a positive integer (placements per ring)",
+    "eval_worlds": (
+        f"a list of distinct eval worlds from {', '.join(EVAL_WORLDS)} (each trial's final agent "
+        "is also tested there; experiments/eval_worlds.py)"
+    ),
     "stick_return": f"one of {', '.join(STICK_RETURNS)}",
     "preset": f"one of {', '.join(PRESETS)}",
     "voice": f"one of {', '.join(TRACTS)}",
@@ -79,6 +84,9 @@ class BatchSpec:
     iterations: int = 1000
     checkpoint_every: int = 1000
     eval_placements: int = 100
+    # Eval worlds (experiments/eval_worlds.py) each trial's final agent is tested in besides
+    # its own, written into eval-in-NAME/ of the trial (one equal to its own is its own).
+    eval_worlds: tuple[str, ...] = ()
     stick_return: str = WorldConfig.stick_return
     preset: str = DEFAULT_PRESET
     voice: str = DEFAULT_TRACT
@@ -99,6 +107,13 @@ class BatchSpec:
                 or len(set(values)) != len(values)
             ):
                 raise _field_error(name, values)
+        worlds = self.eval_worlds
+        if (
+            not isinstance(worlds, tuple)
+            or any(w not in EVAL_WORLDS for w in worlds)
+            or len(set(worlds)) != len(worlds)
+        ):
+            raise _field_error("eval_worlds", worlds)
         if not isinstance(self.seeds, tuple) or not self.seeds:
             raise _field_error("seeds", self.seeds)
         # Every log row records its seed in an int64 column (models/checks.py MAX_SEED).
@@ -235,7 +250,7 @@ def load_spec(
             raise BatchError(f"cannot read batch config {path}: {exc}") from None
     given = _with_base(_read_fields(text, source), source)
     # JSON has lists where the spec has tuples; nothing else is converted.
-    for name in ("grasps", "babbling", "seeds"):
+    for name in ("grasps", "babbling", "seeds", "eval_worlds"):
         if isinstance(given.get(name), list):
             given[name] = tuple(given[name])
     seeds = given.get("seeds")

@@ -14,10 +14,11 @@ from experiments.cli.args import RUN_DEFAULTS, UsageError
 from experiments.cli.overrides import merged
 
 
-def percent(fraction: float) -> str:
+def percent(fraction: float | None) -> str:
     """Competence as the report pages print it (experiments/report/pages.pct, one decimal):
-    "-0.8%", "46.0%", "n/a". Kept here so that the CLI's summaries load no report code."""
-    return "n/a" if not np.isfinite(fraction) else f"{100 * fraction:.1f}%"
+    "-0.8%", "46.0%", "n/a" (also for None: eval.json's null for a number that is not finite).
+    Kept here so that the CLI's summaries load no report code."""
+    return "n/a" if fraction is None or not np.isfinite(fraction) else f"{100 * fraction:.1f}%"
 
 
 def cmd_random(args: argparse.Namespace) -> None:
@@ -83,30 +84,31 @@ def cmd_run(args: argparse.Namespace) -> None:
 def cmd_eval(args: argparse.Namespace) -> None:
     """Competence, strategies and vocal accuracy of a trial's final state."""
     from experiments import storage
-    from experiments.measure.cross_evaluation import evaluate_in_world
+    from experiments.file_names import eval_world_dir
     from experiments.measure.evaluation import EvaluationSettings
     from experiments.measure.trial_evaluation import evaluate_trial
     from experiments.provenance import computed_on_line
     from experiments.run.trial_files import TrialError
 
-    settings = EvaluationSettings(n_placements=args.placements)
-    notify = lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True)  # noqa: E731
     try:
-        if args.world == "own":
-            summary = evaluate_trial(args.dir, settings, progress=not args.quiet, notify=notify)
-        else:
-            summary = evaluate_in_world(
-                args.dir, args.world, settings, progress=not args.quiet, notify=notify
-            )
+        summary = evaluate_trial(
+            args.dir,
+            EvaluationSettings(n_placements=args.placements),
+            progress=not args.quiet,
+            notify=lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True),
+            world=args.world,
+        )
     except (TrialError, storage.CorruptFileError) as exc:
         raise UsageError(str(exc)) from None
     c, v = summary["competence"], summary["vocal"]
-    tested = summary.get("test_world")
-    where = "" if tested is None else f", tested in the {tested['name']} world"
+    tested = summary.get("eval_world")
+    where = "" if tested is None else f", tested in the {tested['name']} world ({_differs(tested)})"
     print(
         f"{args.dir}: {summary['grasp']}, seed {summary['seed']}, "
         f"{summary['evaluated_at_iteration']} iterations{where}"
     )
+    if tested is not None:
+        print(f"  written into {os.path.join(args.dir, eval_world_dir(tested['name']))}")
     print(f"  {computed_on_line(args.dir)}")
     print(
         "  normalised competence (0% = random agent, 100% = perfect): "
@@ -122,6 +124,14 @@ def cmd_eval(args: argparse.Namespace) -> None:
     print(
         "  the study's tests: study-tests.parquet (its measure pools trials per pixel: "
         "`playroom report` of the batch computes it, as the study computed it)"
+    )
+
+
+def _differs(tested: dict) -> str:
+    """How an eval world differs from the trial's own, for a line: "grasp kinematic -> physical"."""
+    return "; ".join(
+        f"{key.split('.')[-1]} {own} -> {test}"
+        for key, (own, test) in tested["differs_from_own"].items()
     )
 
 
@@ -145,7 +155,11 @@ def cmd_batch(args: argparse.Namespace) -> None:
         raise UsageError(str(exc)) from None
     for name, summary in sorted(results.items()):
         c = summary["competence"]
-        print(f"  {name}: competence ring1 {percent(c['ring1'])}, all {percent(c['all'])}")
+        tested = "".join(
+            f"; in the {world} world ring1 {percent(t['ring1'])}, all {percent(t['all'])}"
+            for world, t in summary.get("eval_worlds", {}).items()
+        )
+        print(f"  {name}: competence ring1 {percent(c['ring1'])}, all {percent(c['all'])}{tested}")
     print(f"{args.out}: {len(spec.trials())} trials complete")
 
 
@@ -331,6 +345,7 @@ def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
     except RecordMismatch as exc:
         raise UsageError(str(exc)) from None
     workers = getattr(args, "workers", None)  # None: the machine's cores
+    # The grasp rates play each backend in the world its trials ran in (stick.batch_worlds).
     if n is None:
         return {"measures": room_measures(workers=workers, batch_dirs=batch_dirs)}
     return {"measures": room_measures(n, workers=workers, batch_dirs=batch_dirs)}

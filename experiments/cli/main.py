@@ -36,6 +36,7 @@ from experiments.cli.commands import (
 )
 from experiments.cli.faults import run_command
 from experiments.cli.overrides import dotted_setting
+from experiments.eval_worlds import OWN, WORLD_NAMES
 from learner.config import BABBLING_MODES
 from models.presets import PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
@@ -154,11 +155,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--world",
-        choices=("own", *GRASPS),
-        default="own",
-        help="the world the final agent is tested in: its own (eval.json beside the trial), or "
-        "another backend's with its rules as the trial's preset sets them, written into "
-        "DIR/eval-in-WORLD/ (docs/protocol.md D26); default: own",
+        choices=WORLD_NAMES,
+        default=OWN,
+        help="the world the final agent is tested in: its own (eval.json in DIR), or another "
+        "backend with the switches of the trial's preset, written into DIR/eval-in-WORLD/ "
+        "(one equal to its own is its own; docs/usage.md)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_eval)

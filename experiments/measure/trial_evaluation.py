@@ -1,6 +1,13 @@
 """A trial evaluated after learning: the project's measure (experiments/measure/evaluation.py)
 and the study's tests (experiments/measure/study_measure.py), from the trial's final state,
-written into the trial directory as one unit (eval.json last)."""
+written into the trial directory as one unit (eval.json last).
+
+The final agent can also be tested in an eval world other than its own (experiments/
+eval_worlds.py): the same evaluation, in a room of that world built as the trial's own is
+(`fresh_trial_parts`), written beside the trial's files in `eval-in-NAME/`, whose eval.json
+records the world (`eval_world`). The study's measure there starts from that room's start
+scene, not from the scene learning left, which is a state of the trial's own world
+(docs/protocol.md D26)."""
 
 from __future__ import annotations
 
@@ -9,12 +16,14 @@ from collections.abc import Callable
 from pathlib import Path
 
 from experiments import manifest, provenance, storage
+from experiments.eval_worlds import OWN, EvalWorldError, own_world, world_record
 from experiments.file_names import (
     COMPETENCE_FILE,
     CONFIG_FILE,
     EVAL_FILE,
     STUDY_TESTS_FILE,
     VOCAL_FILE,
+    eval_world_dir,
 )
 from experiments.measure.evaluation import (
     EvaluationSettings,
@@ -24,21 +33,27 @@ from experiments.measure.evaluation import (
 )
 from experiments.measure.study_measure import StudyMeasureSettings, study_tests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.trial_checks import load_trial, remove_litter
-from experiments.run.trial_files import TrialError, TrialLocked
+from experiments.run.trial_checks import is_litter, load_trial, remove_litter
+from experiments.run.trial_files import TrialError, TrialLocked, fresh_trial_parts
+from sim import Playroom
 
 
 def evaluate_trial(
     trial_dir: str | os.PathLike,
     settings: EvaluationSettings | None = None,
-    progress=False,
+    progress: bool = False,
     notify: Callable[[str], None] | None = None,
+    world: str = OWN,
 ) -> dict:
     """Evaluate a trial's final state and write eval.json and the tables beside it, as one
     unit: a write that fails (disk full) leaves the trial's evaluation files as they were.
     TrialError, before any work, for a directory that cannot be written (read-only), or that
     another process writes into (named). The temporary files of killed writers are removed
-    first; `notify` is told their names."""
+    first; `notify` is told their names.
+
+    `world`: an eval world's name (experiments/eval_worlds.py) tests the final agent there
+    and writes into `eval-in-<world>/` instead, the trial's own files untouched; an eval world
+    equal to the trial's own is its own evaluation (`notify` is told so)."""
     settings = settings or EvaluationSettings()
     trial_dir = Path(trial_dir)
     if not (trial_dir / CONFIG_FILE).is_file():  # the lock would make the folder
@@ -59,11 +74,19 @@ def evaluate_trial(
             notify(
                 f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
             )
+        out_dir, room = _where_tested(trial_dir, config, room, world, notify)
         try:  # before minutes of tests whose results could not be kept
-            storage.check_writable(trial_dir)
+            storage.check_writable(out_dir)
         except OSError as exc:
-            raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
-        final_state = room.get_state()  # the study's measure starts from it too
+            raise TrialError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
+        litter = [p.name for p in sorted(out_dir.glob(".*.tmp")) if is_litter(p.name)]
+        for name in litter:  # under the lock, as for the trial's own files
+            (out_dir / name).unlink(missing_ok=True)
+        if litter and notify is not None:
+            notify(f"removed {len(litter)} temporary file(s) of a killed writer in {out_dir}")
+        # The study's measure starts from it too: the scene learning left, or in another
+        # world, that world's start scene.
+        final_state = room.get_state()
         competence = competence_table(agent, room, settings, progress=progress)
         vocal = vocal_table(meta["best_word_distance"], room.words.names)
         summary = summarise_trial(config, competence, vocal)
@@ -71,7 +94,10 @@ def evaluate_trial(
         summary["n_placements"] = settings.n_placements
         # The evaluation is computed too: its numbers carry the machine's bits as well.
         summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
-        # The study measured in the scene learning left, carried over from test to test.
+        if out_dir != trial_dir:
+            summary["eval_world"] = world_record(config, world)
+        # The study measured in the scene its tests start from (above), carried over from
+        # test to test.
         room.set_state(final_state)
         study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
         # eval.json last: it vouches for the tables (storage.write_files). A word's best
@@ -87,7 +113,35 @@ def evaluate_trial(
         # a reader refuses a table lost, damaged or left from another evaluation.
         summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(files)
         files[EVAL_FILE] = storage.json_bytes(storage.finite_or_null(summary))
-        storage.write_files(trial_dir, files)
+        storage.write_files(out_dir, files)
     finally:
         lock.release()
     return summary
+
+
+def _where_tested(
+    trial_dir: Path,
+    config: dict,
+    room: Playroom,
+    world: str,
+    notify: Callable[[str], None] | None,
+) -> tuple[Path, Playroom]:
+    """(the folder the evaluation is written into, the room it tests in): the trial
+    directory and the room restored with the trial for its own world, else `eval-in-<world>/`
+    and a fresh room of that world, built from the trial's config as the trial's own room is
+    (its seed, voice and every setting but the backend and its switches)."""
+    try:
+        own = world == OWN or own_world(config, world)
+    except EvalWorldError as exc:
+        raise TrialError(f"{trial_dir}: {exc}") from None
+    if own:
+        if world != OWN and notify is not None:
+            notify(
+                f"{trial_dir} learned in the {world} world: its evaluation there is its own, "
+                "eval.json in the trial directory (one evaluation per world)"
+            )
+        return trial_dir, room
+    tested = world_record(config, world)
+    trial = {**config["trial"], "grasp": tested["grasp"]}
+    _, tested_room = fresh_trial_parts({**config, "trial": trial, "world": tested["world"]})
+    return trial_dir / eval_world_dir(world), tested_room

@@ -36,7 +36,7 @@ def test_every_option_of_every_command_has_help():
         ("run", ["default: 80000", "default: kinematic", "{kinematic,physical}", "--set"]),
         ("random", ["(default: 20)", "(default: kinematic)", "(default: 0)"]),
         ("render", ["(default: 640x480)", "(default: 50.0)", "(default: top)"]),
-        ("eval", ["(default: 100)"]),
+        ("eval", ["(default: 100)", "{own,kinematic,physical}", "(default: own)"]),
         ("batch", ["smoke", "paper", "dashboard", "--set"]),
         ("bench", ["trial, learner, world, tracking, voice, render, emulated"]),
         ("say", ["{oey,uye,iuo,eyu,eou,yeo}"]),
