@@ -7,11 +7,15 @@ import argparse
 import os
 import sys
 from collections import Counter
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from experiments.cli.args import RUN_DEFAULTS, UsageError
 from experiments.cli.overrides import merged
+
+if TYPE_CHECKING:  # the commands load the simulator when they run (see above)
+    from sim.config import WorldConfig
 
 
 def percent(fraction: float) -> str:
@@ -24,13 +28,16 @@ def cmd_random(args: argparse.Namespace) -> None:
     """Random arm commands in one backend, with a summary of what happened."""
     from models.layout import ARM_DIM
     from sim import Playroom
+    from sim import events as ev
 
-    room = Playroom(grasp=args.grasp, seed=args.seed)
+    room = Playroom(grasp=args.grasp, seed=args.seed, config=_random_world(args))
     rng = np.random.default_rng(args.seed)
     counts: Counter[str] = Counter()
+    commands_with: Counter[str] = Counter()  # commands in which each kind of event happened
     print(f"{args.iterations} random arm commands, {args.grasp} grasping, seed {args.seed}")
     for i in range(args.iterations):
         feedback = room.act_arm(rng.uniform(-1.0, 1.0, ARM_DIM))
+        commands_with.update(set(feedback.kinds()))
         for e in feedback.events:
             counts[f"{e.kind}" + (f" by {e.by}" if e.by else "")] += 1
         if feedback.events:
@@ -41,6 +48,36 @@ def cmd_random(args: argparse.Namespace) -> None:
             )
             print(f"  iteration {i:3d}: {said}")
     print("  totals: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
+    rates = (ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT)
+    print(
+        "  share of commands: "
+        + ", ".join(f"{kind} {percent(commands_with[kind] / args.iterations)}" for kind in rates)
+    )
+
+
+def _random_world(args: argparse.Namespace) -> WorldConfig:
+    """The world of `playroom random`: its preset with the world settings of `--set`, refused
+    (UsageError, one line) where a setting is not the world's, not allowed, or not read by the
+    backend's rules."""
+    from sim.config import inert_settings, world_preset
+
+    try:
+        changes = merged({}, args.set)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    others = sorted(set(changes) - {"world"})
+    if others:
+        raise UsageError(
+            f"random takes world settings only (--set world.NAME=VALUE), not {others[0]}"
+        )
+    world = changes.get("world", {})
+    inert = inert_settings(args.grasp, world)
+    if inert:
+        raise UsageError(f"world.{inert[0]} changes nothing on the {args.grasp} backend")
+    try:
+        return world_preset(args.preset, **world)
+    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
+        raise UsageError(f"--set: {exc}") from None
 
 
 def cmd_run(args: argparse.Namespace) -> None:
