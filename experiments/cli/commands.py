@@ -7,15 +7,11 @@ import argparse
 import os
 import sys
 from collections import Counter
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from experiments.cli.args import RUN_DEFAULTS, UsageError
-from experiments.cli.overrides import merged
-
-if TYPE_CHECKING:  # the commands load the simulator when they run (see above)
-    from sim.config import WorldConfig
+from experiments.cli.overrides import merged, random_world
 
 
 def percent(fraction: float) -> str:
@@ -30,7 +26,11 @@ def cmd_random(args: argparse.Namespace) -> None:
     from sim import Playroom
     from sim import events as ev
 
-    room = Playroom(grasp=args.grasp, seed=args.seed, config=_random_world(args))
+    try:
+        world = random_world(args.grasp, args.preset, args.set)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    room = Playroom(grasp=args.grasp, seed=args.seed, config=world)
     rng = np.random.default_rng(args.seed)
     counts: Counter[str] = Counter()
     commands_with: Counter[str] = Counter()  # commands in which each kind of event happened
@@ -53,31 +53,6 @@ def cmd_random(args: argparse.Namespace) -> None:
         "  share of commands: "
         + ", ".join(f"{kind} {percent(commands_with[kind] / args.iterations)}" for kind in rates)
     )
-
-
-def _random_world(args: argparse.Namespace) -> WorldConfig:
-    """The world of `playroom random`: its preset with the world settings of `--set`, refused
-    (UsageError, one line) where a setting is not the world's, not allowed, or not read by the
-    backend's rules."""
-    from sim.config import inert_settings, world_preset
-
-    try:
-        changes = merged({}, args.set)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    others = sorted(set(changes) - {"world"})
-    if others:
-        raise UsageError(
-            f"random takes world settings only (--set world.NAME=VALUE), not {others[0]}"
-        )
-    world = changes.get("world", {})
-    inert = inert_settings(args.grasp, world)
-    if inert:
-        raise UsageError(f"world.{inert[0]} changes nothing on the {args.grasp} backend")
-    try:
-        return world_preset(args.preset, **world)
-    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
-        raise UsageError(f"--set: {exc}") from None
 
 
 def cmd_run(args: argparse.Namespace) -> None:
