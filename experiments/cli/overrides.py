@@ -1,5 +1,5 @@
 """`--set section.name=value`: one setting of the world or the learner changed from the
-command line (`playroom run`, `playroom batch`), as a batch config's "overrides" change it.
+command line (`playroom run`, `batch`, `random`), as a batch config's "overrides" change it.
 
 The value is read as JSON when it is JSON (0.05, true, [1, 2], "text"), else taken as a string
 (`--set world.stick_return=never` needs no quotes). Only the form is checked here: the names
