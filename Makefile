@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations ablations clean
+.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -90,6 +90,24 @@ contact-ablations: comparison-diva
 	done
 	$(BIN)/playroom ablations $(OUT)/comparison-diva \
 		$(addprefix $(OUT)/contact-ablation-,$(CONTACT_ABLATIONS)) --out $(OUT)/contact-ablations
+
+## contact-ladder: issue 40's rungs from the study's kinematic rules to the physical backend, one
+## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
+## DIVA; rungs 0 and 5 are comparison-diva's halves); a rung that is a contact ablation (the
+## same batch) runs into that ablation's directory. Then `playroom ablations` of every rung
+## against comparison-diva: rows pair by backend, so the kinematic rungs (1, 2) against its
+## kinematic trials, the physical ones (3, 4, 6) against its physical trials. Resumes
+CONTACT_LADDER := $(basename $(notdir $(wildcard experiments/batches/contact-ladder/*.json)))
+contact-ladder: comparison-diva
+	dirs=; for rung in $(CONTACT_LADDER); do \
+		name=$${rung#*-}; out=$(OUT)/contact-ladder-$$rung; \
+		if [ -f experiments/batches/contact-ablations/$$name.json ]; then \
+			out=$(OUT)/contact-ablation-$$name; fi; \
+		$(BIN)/playroom batch --config experiments/batches/contact-ladder/$$rung.json \
+			--out $$out || exit 1; \
+		dirs="$$dirs $$out"; \
+	done; \
+	$(BIN)/playroom ablations $(OUT)/comparison-diva $$dirs --out $(OUT)/contact-ladder
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the

@@ -29,6 +29,8 @@ from models.tracts import DEFAULT_TRACT, TRACTS
 # them, import them from here, so that a config is checked without importing either.
 DMP_KINDS = ("study", "project")  # sim/dmp.py
 CATCH_RULES = ("study", "held_stick")  # sim/grasping/kinematic.py
+ARM_DYNAMICS = ("set", "servo")  # sim/grasping/kinematic.py, sim/arm_servo.py
+HELD_POSES = ("touch", "aligned")  # sim/grasping/physical.py
 STICK_RETURNS = ("never", "out_of_reach")  # sim/experimenter.py
 N_RINGS = 3  # the study's rings; evaluations and reports name them ring1..ring3
 # With push_objects off: the table damping of an unheld object (20 on x, y in the MJCF) times
@@ -120,6 +122,21 @@ class WorldConfig:
     settle_between_movements: bool = dataclasses.field(
         default=False, metadata={BEFORE: False, ACTS_ON: ("physical",)}
     )
+    # A rung of the contact ladder (issue 40), never a default: how the kinematic rules move
+    # the arm. "set": its joints are set to the DMP targets (the study's rule); "servo": they
+    # are where the physical model's position servos, tracking the same targets through the
+    # dynamics with the arm touching nothing, take them (sim/arm_servo.py); the grasp, catch
+    # and placement rules then act on that arm. Older trials set the arm.
+    arm_dynamics: str = dataclasses.field(
+        default="set", metadata={BEFORE: "set", ACTS_ON: ("kinematic",)}
+    )
+    # A rung of the contact ladder (issue 40), never a default: where the physical backend
+    # holds what it takes. "touch": welded at the pose of the touch (D16); "aligned": placed
+    # and welded as the kinematic rules hold it, the stick's handle at the hand pointing along
+    # the last segment, a toy at the hand or at the held stick's tip. Older trials: "touch".
+    held_pose: str = dataclasses.field(
+        default="touch", metadata={BEFORE: "touch", ACTS_ON: ("physical",)}
+    )
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a
@@ -148,6 +165,8 @@ class WorldConfig:
         if self.stick_return_reach is not None:
             check_number(w + "stick_return_reach", self.stick_return_reach, lengths)
         check_choice(w + "voice", self.voice, TRACTS)
+        check_choice(w + "arm_dynamics", self.arm_dynamics, ARM_DYNAMICS)
+        check_choice(w + "held_pose", self.held_pose, HELD_POSES)
         for name in ("push_objects", "settle_between_movements"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"{w}{name} must be true or false, got {getattr(self, name)!r}")

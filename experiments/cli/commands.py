@@ -11,7 +11,7 @@ from collections import Counter
 import numpy as np
 
 from experiments.cli.args import RUN_DEFAULTS, UsageError
-from experiments.cli.overrides import merged
+from experiments.cli.overrides import merged, random_world
 
 
 def percent(fraction: float | None) -> str:
@@ -25,13 +25,20 @@ def cmd_random(args: argparse.Namespace) -> None:
     """Random arm commands in one backend, with a summary of what happened."""
     from models.layout import ARM_DIM
     from sim import Playroom
+    from sim import events as ev
 
-    room = Playroom(grasp=args.grasp, seed=args.seed)
+    try:
+        world = random_world(args.grasp, args.preset, args.set)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    room = Playroom(grasp=args.grasp, seed=args.seed, config=world)
     rng = np.random.default_rng(args.seed)
     counts: Counter[str] = Counter()
+    commands_with: Counter[str] = Counter()  # commands in which each kind of event happened
     print(f"{args.iterations} random arm commands, {args.grasp} grasping, seed {args.seed}")
     for i in range(args.iterations):
         feedback = room.act_arm(rng.uniform(-1.0, 1.0, ARM_DIM))
+        commands_with.update(set(feedback.kinds()))
         for e in feedback.events:
             counts[f"{e.kind}" + (f" by {e.by}" if e.by else "")] += 1
         if feedback.events:
@@ -42,6 +49,11 @@ def cmd_random(args: argparse.Namespace) -> None:
             )
             print(f"  iteration {i:3d}: {said}")
     print("  totals: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
+    rates = (ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT)
+    print(
+        "  share of commands: "
+        + ", ".join(f"{kind} {percent(commands_with[kind] / args.iterations)}" for kind in rates)
+    )
 
 
 def cmd_run(args: argparse.Namespace) -> None:

@@ -38,7 +38,7 @@ from experiments.cli.faults import run_command
 from experiments.cli.overrides import dotted_setting
 from experiments.eval_worlds import OWN, WORLD_NAMES
 from learner.config import BABBLING_MODES
-from models.presets import PRESETS
+from models.presets import DEFAULT_PRESET, PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
@@ -97,6 +97,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--grasp", choices=GRASPS, default=DEFAULT_GRASP, help="the grasp backend")
     p.add_argument("--iterations", type=positive_int, default=20, help="arm commands to play")
     p.add_argument("--seed", type=non_negative_int, default=0, help="of the room and commands")
+    p.add_argument(
+        "--preset",
+        choices=PRESETS,
+        default=DEFAULT_PRESET,
+        help="the room's world: as the study's code behaved, or the project's "
+        "(default: %(default)s)",
+    )
+    _set_option(p, "world settings only (e.g. a rung of the contact ladder, docs/world.md)")
     p.set_defaults(func=cmd_random)
 
     p = sub.add_parser("run", help="one trial of Model Babbling into a directory")

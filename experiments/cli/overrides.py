@@ -1,5 +1,5 @@
 """`--set section.name=value`: one setting of the world or the learner changed from the
-command line (`playroom run`, `playroom batch`), as a batch config's "overrides" change it.
+command line (`playroom run`, `batch`, `random`), as a batch config's "overrides" change it.
 
 The value is read as JSON when it is JSON (0.05, true, [1, 2], "text"), else taken as a string
 (`--set world.stick_return=never` needs no quotes). Only the form is checked here: the names
@@ -10,7 +10,10 @@ from __future__ import annotations
 import argparse
 import copy
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # loaded when `random_world` runs: building the parser loads no simulator
+    from sim.config import WorldConfig
 
 # The sections an override may change (experiments/run/settings.py OVERRIDABLE).
 SECTIONS = ("world", "learner")
@@ -48,3 +51,27 @@ def merged(overrides: dict, settings: list[tuple[str, str, Any]] | None) -> dict
         given.add((section, name))
         out.setdefault(section, {})[name] = value
     return out
+
+
+def random_world(
+    grasp: str, preset: str, settings: list[tuple[str, str, Any]] | None
+) -> WorldConfig:
+    """The WorldConfig of `playroom random`: the preset's world with the `--set` settings,
+    which must be the world's, allowed, and read by the backend `grasp`'s rules; ValueError
+    (one line) otherwise."""
+    from sim.config import inert_settings, world_preset
+
+    changes = merged({}, settings)
+    others = sorted(set(changes) - {"world"})
+    if others:
+        raise ValueError(
+            f"random takes world settings only (--set world.NAME=VALUE), not {others[0]}"
+        )
+    world = changes.get("world", {})
+    inert = inert_settings(grasp, world)
+    if inert:
+        raise ValueError(f"world.{inert[0]} changes nothing on the {grasp} backend")
+    try:
+        return world_preset(preset, **world)
+    except TypeError as exc:  # an unknown field
+        raise ValueError(f"--set: {exc}") from None

@@ -8,6 +8,10 @@ first step at which a distance drops below its threshold, and held objects follo
 the held stick's tip) from that step on. tests/sim/test_kinematic_paths.py compares the two
 forms on thousands of commands, sample by sample and event by event: change a rule in both
 forms, and run it.
+
+Under `WorldConfig.arm_dynamics` "servo" (a rung of the contact ladder, issue 40) the arm is
+where the physical model's servos take it while tracking the targets (sim/arm_servo.py), not at
+the targets: both forms read its angles from the same servo steps, and the rules act on them.
 """
 
 from __future__ import annotations
@@ -19,8 +23,11 @@ import numpy as np
 
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
+from sim.arm_servo import ArmServo
+from sim.config import WorldConfig
 from sim.grasping.base import ArmMovement, ClosedForm, Holds, arm_to_rest
 from sim.kinematics import hand_positions
+from sim.model_edits import ModelEdits
 from sim.physics import PlayroomPhysics
 
 
@@ -64,20 +71,31 @@ class KinematicPhysics(PlayroomPhysics):
 
 
 class KinematicGrasp(ClosedForm):
-    """The arm follows its targets exactly and objects attach by distance. Held objects are
-    placed, not simulated."""
+    """The arm follows its targets exactly (or its servos', `arm_dynamics` "servo") and objects
+    attach by distance. Held objects are placed, not simulated."""
 
     name = "kinematic"
     physics_class = KinematicPhysics
     solid = False
     _arm_moved = False  # whether a stepped movement moved the arm from rest (`release`)
 
+    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
+        super().__init__(config, edits)
+        # The servo-driven arm under arm_dynamics "servo"; None: the arm is set to its targets.
+        self._servo = ArmServo() if config.arm_dynamics == "servo" else None
+
+    def begin(self, physics: PlayroomPhysics) -> None:
+        super().begin(physics)
+        if self._servo is not None:  # every movement starts from rest
+            self._servo.reset()
+
     # Arm movements: the grasp and catch rules, stepped ------------------------------------
     def before_step(
         self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
     ) -> list[ev.Event]:
         d = physics.data.ptr
-        d.qpos[physics.arm_qpos] = joint_targets
+        servo = self._servo
+        d.qpos[physics.arm_qpos] = joint_targets if servo is None else servo.step(joint_targets)
         self._arm_moved = True
         mujoco.mj_kinematics(physics.model.ptr, d)
         events = self._attach_by_distance(physics, step)
@@ -158,9 +176,12 @@ class KinematicGrasp(ClosedForm):
         from sim.grasping import kinematic_kernel as kernel
 
         config = self.config
+        # The arm's joint angles after each step: its targets, or where its servos take it
+        # (the same servo steps as `before_step`'s, from rest).
+        angles = joint_targets if self._servo is None else self._servo.path(joint_targets)
         # sim/kinematics.hand_positions' angles, cosines and sines; the rules themselves run
         # compiled (sim/grasping/kinematic_kernel.py), with the same arithmetic.
-        absolute = joint_targets.cumsum(axis=0) + config.arm_rest_offset  # (3, N_STEPS)
+        absolute = angles.cumsum(axis=0) + config.arm_rest_offset  # (3, N_STEPS)
         cos, sin = np.cos(absolute), np.sin(absolute)
         study_catch = config.catch_rule == "study"
         lying_tip = stick_pose[:2]  # read by the kernel only under the study's catch rule

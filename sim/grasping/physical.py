@@ -3,6 +3,11 @@ targets through the dynamics; the hand takes the stick when it touches the handl
 when it touches it; the stick's tip catches a toy it touches. A grasp activates a weld equality
 holding the current relative pose. Unheld objects are pushed by whatever touches them. The
 caregiver carries a toy with her hand, a mocap body welded to it, lifted above the table.
+
+Under `WorldConfig.held_pose` "aligned" (a rung of the contact ladder, issue 40) what is taken
+is first placed where the kinematic rules hold it (sim/grasping/kinematic.py): the stick's
+handle at the hand, the stick along the last segment; a toy at the hand, or at the held stick's
+tip; the weld then holds that pose.
 """
 
 from __future__ import annotations
@@ -83,6 +88,8 @@ class PhysicalGrasp(GraspBackend):
                 self.hand_holds = "stick"
                 self._hold(physics, "hand_stick", "stick")
                 events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
+                if self.config.held_pose == "aligned":  # the tip is where the stick now lies
+                    found = physics.grasp_contacts() > 0
             elif toys.any():
                 toy = TOYS[int(np.argmax(toys))]
                 self.hand_holds = toy
@@ -106,9 +113,11 @@ class PhysicalGrasp(GraspBackend):
         MuJoCo makes a contact when one geom's contype meets the other's conaffinity, so a
         holder and its object each lose the other's bit from their conaffinity.
         """
+        holder = weld.split("_")[0]
+        if self.config.held_pose == "aligned":
+            _place_as_the_rules_hold(physics, holder, obj)
         self.edits.weld_here(self.name, weld)
         self.edits.lift(self.name, OBJECTS.index(obj))
-        holder = weld.split("_")[0]
         holder_geoms = [physics.hand_geom] if holder == "hand" else list(physics.stick_geoms)
         object_geoms = (
             list(physics.stick_geoms) if obj == "stick" else [physics.toy_geoms[TOYS.index(obj)]]
@@ -120,6 +129,11 @@ class PhysicalGrasp(GraspBackend):
             self.edits.ignore(self.name, geom, object_bit)
         for geom in object_geoms:
             self.edits.ignore(self.name, geom, holder_bit)
+        if self.config.held_pose == "aligned":
+            # Everything the next physics step starts from, computed for the room as it is now
+            # (the object moved, the weld on, its collisions edited): without it that step
+            # would integrate contact forces found with the object where the touch left it.
+            mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
 
     def release(self, physics: PlayroomPhysics) -> None:
         self.hand_holds = None
@@ -201,3 +215,18 @@ class PhysicalGrasp(GraspBackend):
         sizes = physics.model.ptr.geom_size
         contact = sizes[physics.hand_geom, 0] + sizes[physics.handle_geom, 0]
         return float(self.config.arm_length + contact)
+
+
+def _place_as_the_rules_hold(physics: PlayroomPhysics, holder: str, obj: str) -> None:
+    """Put `obj` where the kinematic rules hold what `holder` ("hand" or "stick") takes: the
+    stick's handle at the hand, pointing along the last segment; a toy at the hand or at the
+    stick's tip, its yaw kept. Still, with the positions updated (the weld reads them)."""
+    row = OBJECTS.index(obj)
+    place = physics.hand_position() if holder == "hand" else physics.stick_tip()
+    d = physics.data.ptr
+    qpos, dof = physics.object_qpos[row], physics.object_dof[row]
+    d.qpos[qpos[:2]] = place
+    if obj == "stick":
+        d.qpos[qpos[2]] = physics.hand_angle()
+    d.qvel[dof] = 0.0
+    mujoco.mj_kinematics(physics.model.ptr, d)

@@ -125,7 +125,12 @@ def test_a_setting_set_twice_on_the_command_line_is_one_line_and_writes_nothing(
 
 
 @pytest.mark.parametrize(
-    "setting", ["world.push_objects=false", "world.settle_between_movements=true"]
+    "setting",
+    [
+        "world.push_objects=false",
+        "world.settle_between_movements=true",
+        "world.held_pose=aligned",
+    ],
 )
 def test_a_world_switch_the_backend_never_reads_is_refused(tmp_path, capsys, setting):
     out = tmp_path / "trial"

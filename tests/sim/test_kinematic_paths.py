@@ -99,6 +99,17 @@ def test_kinematic_whole_movements_equal_the_stepped_rules_on_random_commands(co
         assert ev.WORD_RECOGNISED in kinds
 
 
+def test_kinematic_whole_movements_equal_the_stepped_rules_with_the_servo_arm():
+    """Under arm_dynamics "servo" both forms read the arm's angles from the same servo steps
+    (sim/arm_servo.py), and the rules act on them alike."""
+    servo_world = dataclasses.replace(STUDY_WORLD, arm_dynamics="servo")
+    fast, stepped = _twin_rooms("kinematic", seed=5, config=servo_world)
+    kinds: set[str] = set()
+    for space, m in _random_commands(np.random.default_rng(0), 300):
+        kinds.update(_same(fast, stepped, space, m))
+    assert {ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT} <= kinds
+
+
 @pytest.mark.slow  # over 5 s: make test-slow runs it
 def test_kinematic_whole_movements_equal_the_stepped_rules_on_scripted_tool_use():
     """Scripted scenes: take the handle, then sweep the tip through a toy, from many places."""
