@@ -283,6 +283,19 @@ def warn_unchecked(trials: str | os.PathLike) -> None:
     )
 
 
+def warn_unchecked_once(
+    batch_dir: Path, dirs: list[Path], caught: list[warnings.WarningMessage]
+) -> None:
+    """The warnings reading a batch's trials raised (`caught`), again, those of trials written
+    before manifests as one line for the batch."""
+    unchecked = [d.name for d in dirs if any(str(d) in str(w.message) for w in caught)]
+    for w in caught:
+        if not issubclass(w.category, UncheckedTrialWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if unchecked:
+        warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
+
+
 def evaluation_files(files: dict[str, bytes]) -> dict[str, list]:
     """eval.json's EVAL_FILES_KEY entry: each table of an evaluation, name -> [size, sha256]."""
     return {name: entry_of(data).as_json() for name, data in files.items()}

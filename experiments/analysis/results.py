@@ -29,6 +29,7 @@ from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
+from experiments.backend_record import CAPABILITIES
 from experiments.config_file import with_added_settings
 from experiments.file_names import (
     COMPETENCE_FILE,
@@ -59,7 +60,8 @@ class BatchResults:
     - trials: eval.json's numbers (competence_all, competence_ring1..3, share_below_threshold,
       median_names, median_distractors, ...), diverged iterations, timing.json's
       seconds / timed_iterations (NaN when not recorded), and `reach`, how far the hand can
-      take the stick (m) as the trial's backend declared it (backend.json).
+      take the stick (m), and its capabilities (solid, pushes, closed_form: true or false),
+      as the trial's backend declared them (backend.json).
     - competence: competence.parquet rows (ring, placement, toy, x, y, distance, strategy,
       error, random_error, ...).
     - vocal: vocal.parquet rows (word, is_name, toy, best_distance); `toy` (the toy a name
@@ -265,13 +267,14 @@ def _timing(trial_dir: Path) -> tuple[float, float]:
         raise ReportError(f"{path} lacks 'seconds' and 'iterations' numbers") from None
 
 
-def _backend_reach(trial_dir: Path, config: dict) -> float:
-    """How far the trial's hand can take the stick's handle (m), as its backend declared it
-    (experiments/backend_record.py: trials from before the record, from their config)."""
+def _backend(trial_dir: Path, config: dict) -> dict[str, Any]:
+    """What the trial's backend declared (experiments/backend_record.py; older trials: from
+    their config): its `reach` (m) and capabilities, what it cannot do by construction."""
     try:
-        return float(backend_record.read_record(trial_dir, config)["reach"])
+        record = backend_record.read_record(trial_dir, config)
     except (storage.CorruptFileError, ValueError) as exc:
         raise ReportError(str(exc)) from None
+    return {"reach": float(record["reach"]), **{k: bool(record[k]) for k in CAPABILITIES}}
 
 
 def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]:
@@ -303,7 +306,7 @@ def _trial_rows(
         **keys,
         "path": str(d),
         "grasp": config["trial"]["grasp"],
-        "reach": _backend_reach(d, config),
+        **_backend(d, config),
         "babbling": config["trial"]["babbling"],
         "iterations": config["trial"]["iterations"],
         "n_placements": summary.get("n_placements"),
@@ -317,19 +320,6 @@ def _trial_rows(
     study = _read_table(evaluated / STUDY_TESTS_FILE, summary)  # none: evaluated before it
     study = None if study is None else study.assign(**keys)
     return row, comp, voc, curve, study
-
-
-def _warn_once_for_unchecked(
-    batch_dir: Path, dirs: list[Path], caught: list[warnings.WarningMessage]
-) -> None:
-    """The warnings reading the trials raised, again, those of trials written before manifests
-    as one line for the batch (experiments/manifest.py)."""
-    unchecked = [d.name for d in dirs if any(str(d) in str(w.message) for w in caught)]
-    for w in caught:
-        if not issubclass(w.category, manifest.UncheckedTrialWarning):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    if unchecked:
-        manifest.warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
 
 
 def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Path) -> BatchResults:
@@ -374,7 +364,7 @@ def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Pat
             _trial_rows(d, config, summary, label, eval_dir(d))
             for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
         ]
-    _warn_once_for_unchecked(batch_dir, dirs, caught)
+    manifest.warn_unchecked_once(batch_dir, dirs, caught)
     trials, competence, vocal, curves, study = zip(*rows, strict=True)
     where = [
         row

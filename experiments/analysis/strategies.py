@@ -55,32 +55,52 @@ def with_distance(tests: pd.DataFrame) -> pd.DataFrame:
     return tests.assign(distance=np.hypot(tests["x"], tests["y"]))
 
 
+def _with_definition(tests: pd.DataFrame, definition: str) -> pd.DataFrame:
+    """The tests with their distance and `definition`'s strategy column; no rows where a test
+    does not record it (the definition is then not recorded for the batch)."""
+    if tests.empty or "strategy" not in tests.columns:
+        return tests.iloc[:0]
+    tests = with_distance(tests)
+    if COLUMN[definition] not in tests.columns:
+        tests = tests.assign(strategy_held=held_strategy(tests))
+    return tests.iloc[:0] if tests[COLUMN[definition]].isna().any() else tests
+
+
+def trial_shares(tests: pd.DataFrame, low: float, high: float, definition: str) -> pd.DataFrame:
+    """Per trial with tests whose toy lies in [low, high) from the arm's base: each strategy's
+    share of them under `definition` ("study" or "held"), and n_tests. Columns trial, group,
+    seed (where the tests carry it), hand, tool, vocal, n_tests; no row for a trial without
+    tests there. Empty where the tests do not record the definition."""
+    keys = [k for k in ("trial", "group", "seed") if k in tests.columns]
+    tests = _with_definition(tests, definition)
+    inside = tests[(tests["distance"] >= low) & (tests["distance"] < high)] if len(tests) else tests
+    if inside.empty:
+        return pd.DataFrame(columns=[*keys, *STRATEGIES, "n_tests"])
+    column = COLUMN[definition]
+    counts = inside.groupby(keys, sort=False)[column].value_counts().unstack(fill_value=0)
+    counts = counts.reindex(columns=list(STRATEGIES), fill_value=0)
+    n = counts.sum(axis=1)
+    shares = counts.div(n, axis=0).assign(n_tests=n)
+    return shares.reset_index().rename_axis(columns=None)
+
+
 def share_intervals(
     tests: pd.DataFrame, regions: dict[str, tuple[float, float]], definition: str
 ) -> pd.DataFrame:
     """Per group, region and strategy: the mean over trials of each trial's share of its tests
-    in the region, with its 95% interval; its pooled count of tests, n_trials, n_tests. Columns
-    group, definition, region, strategy, mean, low, high, count, n_trials, n_tests. No rows for
-    a definition the tests do not record."""
-    tests = with_distance(tests)
-    column = COLUMN[definition]
-    if column not in tests.columns:
-        tests = tests.assign(strategy_held=held_strategy(tests))
+    in the region (`trial_shares`), with its 95% interval; its pooled count of tests,
+    n_trials, n_tests. Columns group, definition, region, strategy, mean, low, high, count,
+    n_trials, n_tests. No rows for a definition the tests do not record."""
     rows: list[dict] = []
-    if tests[column].isna().any():
+    if _with_definition(tests, definition).empty:
         return pd.DataFrame(rows, columns=_COLUMNS)
-    for group, table in tests.groupby("group", sort=False):
-        for region, (low, high) in regions.items():
-            inside = table[(table["distance"] >= low) & (table["distance"] < high)]
-            per_trial = (
-                inside.groupby("trial")[column].value_counts(normalize=True).unstack(fill_value=0)
-            )
+    for region, (low, high) in regions.items():
+        per_trial = trial_shares(tests, low, high, definition)
+        for group in dict.fromkeys(tests["group"]):
+            trials = per_trial[per_trial["group"] == group]
+            n_tests = trials["n_tests"].to_numpy()
             for strategy in STRATEGIES:
-                values = (
-                    per_trial[strategy].to_numpy(dtype=float)
-                    if strategy in per_trial.columns
-                    else np.zeros(len(per_trial))
-                )
+                values = trials[strategy].to_numpy(dtype=float)
                 mean, lo, hi = mean_ci(values) if len(values) else (math.nan,) * 3
                 rows.append(
                     {
@@ -91,9 +111,9 @@ def share_intervals(
                         "mean": mean,
                         "low": lo,
                         "high": hi,
-                        "count": int((inside[column] == strategy).sum()),
+                        "count": int(np.round(values * n_tests).sum()),
                         "n_trials": len(values),
-                        "n_tests": len(inside),
+                        "n_tests": int(n_tests.sum()),
                     }
                 )
     return pd.DataFrame(rows, columns=_COLUMNS)

@@ -44,7 +44,6 @@ from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.config_file import with_added_settings
 from experiments.eval_worlds import EvalWorldError, own_world
 from experiments.file_names import (
-    BACKEND_FILE,
     BATCH_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
@@ -59,7 +58,7 @@ from experiments.run import estimate, memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.run.trial_checks import check_logs
+from experiments.run.trial_checks import check_files
 from experiments.run.trial_files import TrialError, check_identity
 from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 
@@ -106,14 +105,9 @@ def is_complete(trial_dir: Path) -> bool:
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
         check_identity(trial_dir / CHECKPOINT_FILE, meta, config)
-        # Every file as the trial's manifest recorded it (experiments/manifest.py), and the
-        # evaluation's tables as its eval.json lists them: a damaged one is run again, which
-        # mends what can be mended (backend.json, an evaluation) and says what cannot.
-        recorded = manifest.read_manifest(trial_dir, meta)
-        check_logs(trial_dir, int(meta["iteration"]), None, recorded)
-        backend = trial_dir / BACKEND_FILE
-        if recorded is not None and backend in recorded:
-            recorded.read_bytes(backend, "")
+        # Every file as recorded (manifest, eval.json): a damaged one is run again, which mends
+        # what can be mended (backend.json, an evaluation) and names what cannot.
+        check_files(trial_dir, meta, with_added_settings(config))
         for name in EVALUATION_TABLES:
             manifest.read_evaluation_file(trial_dir, name, summary)
     except (OSError, KeyError, storage.CorruptFileError, TrialError):

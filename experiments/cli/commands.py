@@ -63,8 +63,7 @@ def cmd_run(args: argparse.Namespace) -> None:
     from experiments.run.trial import run_trial
     from experiments.run.trial_files import TrialError
 
-    # Options left out are None: a new trial takes the documented defaults, a resumed one
-    # its own settings, which those given must match.
+    # Left out: None. A new trial takes the defaults, a resumed one its own settings.
     given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
     if args.set:
         try:

@@ -8,14 +8,18 @@ baseline restricted to the seeds the ablation batches hold (e.g. seeds 0-31 of a
 replication). A row is labelled by what its settings change from the baseline's, read from the
 trials' config.json, so the table cannot name a setting that was not changed.
 
-Numbers per row, each computed as `playroom report` computes it (experiments.analysis.stats,
-experiments.measure.study_measure): the competence and strategy shares as the study computed them,
-the project's competence with the mean paired difference from the baseline (95% interval,
-paired t test, two-sided), the share of words imitated within the recognition distance, the
-median best distance of names and distractors, and the Mann-Whitney test of names against
-distractors, its p two-sided as the study computed it (the one-sided p doubled; the convention
-is in the CSV column's name). Written: ablations.md (the table), ablations.csv (every number,
-unrounded), ablations.png (the paired differences and the names effect, one line per row).
+Numbers per row: the competence and strategy shares as the study computed them
+(experiments.measure.study_measure); the measures of the registry marked for this table
+(experiments/report/measures.py: the project's competence, each trial's share of words
+imitated within the recognition distance, each trial's gap between its distractors and its
+names), each a mean over the row's trials with the mean paired difference from the baseline
+(95% interval, paired t test over seeds, two-sided), the gap also against 0 within the row;
+Holm's correction over every test of the table (experiments/report/ablation_tests.py). Then,
+as the study reported them, the median best distance of the pooled names and distractors and
+their Mann-Whitney test on the pooled words, its p two-sided as the study computed it (the
+one-sided p doubled): a second line, which treats words as independent. Written:
+ablations.md (the table), ablations.csv (every number, unrounded), ablations.png (the paired
+differences and the names effect, one line per row).
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ import math
 import os
 import re
 import textwrap
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import pandas as pd
@@ -34,10 +38,13 @@ from experiments import storage
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
-from experiments.analysis.stats import STRATEGIES, paired_difference, vocal_summary
+from experiments.analysis.stats import STRATEGIES, vocal_summary
+from experiments.analysis.trial_tests import ALPHA
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
-from experiments.report import paper
+from experiments.report import ablation_tests, paper
+from experiments.report.ablation_tests import AblationNumbers
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
+from experiments.report.measures import GAP, Measure, registry
 from experiments.report.pages import pct
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
@@ -46,6 +53,8 @@ BOOKKEEPING = ("trial.preset", "trial.overrides")
 MIRRORED = ("world.stick_return", "world.voice")
 # The study's regions, in the order the table shows them (experiments.measure.study_measure).
 STUDY_REGIONS = ("centre", "between_limits", "distance_1")
+# The measure whose paired differences the figure's left panel draws.
+COMPETENCE = "competence_all"
 
 
 @dataclass(frozen=True)
@@ -58,17 +67,13 @@ class AblationRow:
     n_trials: int
     study_competence: float
     study_strategies: dict[str, dict[str, float]]  # region -> strategy -> share
-    competence: float  # the project's measure, mean over trials
-    difference: float  # mean paired difference from the baseline (NaN for the baseline)
-    difference_low: float
-    difference_high: float
-    difference_p: float
-    n_pairs: int
-    words_within: float
+    # The registry's measures of this table (name -> numbers over trials, paired by seed).
+    measures: dict[str, AblationNumbers]
+    # The study's numbers on the pooled words: medians, and the Mann-Whitney p of names vs
+    # distractors, two-sided as the study (the one-sided p doubled); treats words as independent.
     median_names: float
     median_distractors: float
-    # Mann-Whitney names vs distractors, the study's two-sided p (the one-sided p doubled).
-    names_vs_distractors_p_two_sided: float
+    pooled_names_vs_distractors_p_two_sided: float
 
 
 def describe_change(baseline: dict, config: dict) -> str:
@@ -88,39 +93,25 @@ def _row(
     results: BatchResults,
     group: str,
     label: str,
-    measures: RoomMeasures,
+    room: RoomMeasures,
+    measures: tuple[Measure, ...],
     baseline: BatchResults | None,
 ) -> AblationRow:
     results = results.select(group)
-    trials = results.trials.sort_values("seed")
-    study = measures.study_numbers(results).get(group)
-    vocal = results.vocal
-    summary = vocal_summary(vocal, Geometry.of(results).threshold)
-    difference = (math.nan,) * 4
-    n_pairs = 0
-    if baseline is not None:
-        base = baseline.select(group).trials.set_index("seed")["competence_all"]
-        mine = trials.set_index("seed")["competence_all"]
-        common = sorted(set(base.index) & set(mine.index))
-        n_pairs = len(common)
-        difference = paired_difference(mine[common].to_numpy(), base[common].to_numpy())
+    study = room.study_numbers(results).get(group)
+    summary = vocal_summary(results.vocal, Geometry.of(results).threshold)
+    theirs = baseline.select(group) if baseline is not None else None
     return AblationRow(
         label=label,
         batch=results.batch_dir.name,
         group=group,
-        n_trials=len(trials),
+        n_trials=len(results.trials),
         study_competence=study["competence"]["all"] if study else math.nan,
         study_strategies=study["strategy_share"] if study else {},
-        competence=float(trials["competence_all"].mean()),
-        difference=difference[0],
-        difference_low=difference[1],
-        difference_high=difference[2],
-        difference_p=difference[3],
-        n_pairs=n_pairs,
-        words_within=summary["share_below"],
+        measures={m.name: ablation_tests.numbers(m, results, theirs) for m in measures},
         median_names=summary["median_names"],
         median_distractors=summary["median_distractors"],
-        names_vs_distractors_p_two_sided=summary["p"],
+        pooled_names_vs_distractors_p_two_sided=summary["p"],
     )
 
 
@@ -130,8 +121,16 @@ def ablation_rows(
     measures: RoomMeasures,
 ) -> list[AblationRow]:
     """The baseline's row first, then one row per group of each batch that the baseline also
-    holds. ReportError (one line) for a batch that cannot be read or shares no group and no
-    seed with the baseline."""
+    holds, with Holm's adjustment over the table's tests. ReportError (one line) for a batch
+    that cannot be read or shares no group and no seed with the baseline."""
+    return _rows_and_measures(baseline_dir, batch_dirs, measures)[0]
+
+
+def _rows_and_measures(
+    baseline_dir: str | os.PathLike,
+    batch_dirs: list[str | os.PathLike],
+    room: RoomMeasures,
+) -> tuple[list[AblationRow], tuple[Measure, ...]]:
     if not batch_dirs:
         raise ReportError("give at least one batch to compare with the baseline")
     baseline = collect(baseline_dir)
@@ -151,8 +150,9 @@ def ablation_rows(
         seeds |= mine
         pairs += [(results, g) for g in groups]
     baseline = baseline.with_seeds(seeds)
+    measures = ablation_tests.ablation_measures(registry(Geometry.of(baseline)))
     rows = [
-        _row(baseline, g, f"baseline ({baseline.batch_dir.name})", measures, None)
+        _row(baseline, g, f"baseline ({baseline.batch_dir.name})", room, measures, None)
         for g in baseline.groups
         if any(g == group for _, group in pairs)
     ]
@@ -160,8 +160,9 @@ def ablation_rows(
     for results, group in pairs:
         label = describe_change(baseline.configs[group], results.configs[group])
         label = f"{label} [{group}]" if several else label
-        rows.append(_row(results, group, label, measures, baseline))
-    return rows
+        rows.append(_row(results, group, label, room, measures, baseline))
+    adjusted = ablation_tests.with_holm([row.measures for row in rows])
+    return [replace(r, measures=m) for r, m in zip(rows, adjusted, strict=True)], measures
 
 
 def _percent(value: float, digits: int = 0) -> str:
@@ -179,44 +180,55 @@ def _number(value: float, form: str) -> str:
     return "n/a" if not math.isfinite(value) else format(value, form)
 
 
-def markdown_table(rows: list[AblationRow]) -> str:
-    """The table of `ablation_rows`, in Markdown."""
-    head = (
-        "| configuration | trials | competence, study's measure | hand/tool/vocal centre | "
-        "between limits | distance 1 | competence, project's measure (paired difference "
-        "from the baseline, 95% CI, two-sided paired t p) | words within the recognition distance "
-        "| median names / distractors | names vs distractors, Mann-Whitney two-sided p (one-sided "
-        "doubled, as the study) |"
-    )
-    lines = [head, "|" + "---|" * 10]
+def markdown_table(rows: list[AblationRow], measures: tuple[Measure, ...]) -> str:
+    """The table of `ablation_rows` in Markdown, `measures` its registry columns, with a line
+    under it of how many tests it makes and how many survive Holm's correction."""
+    gaps = [m for m in measures if m.test == GAP]
+    head = [
+        "configuration",
+        "trials",
+        "competence, study's measure",
+        "hand/tool/vocal centre",
+        "between limits",
+        "distance 1",
+        *(ablation_tests.header(m) for m in measures),
+        *(f"{m.short or m.label}: against 0, one-sample t p over trials" for m in gaps),
+        "median names / distractors (pooled words)",
+        "names vs distractors pooled over words (Mann-Whitney two-sided p, one-sided doubled as "
+        "the study; treats words as independent)",
+    ]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for row in rows:
-        competence = _percent(row.competence, 1)
-        if math.isfinite(row.difference):
-            competence += (
-                f" ({100 * row.difference:+.1f} [{100 * row.difference_low:+.1f}, "
-                f"{100 * row.difference_high:+.1f}], p = {_number(row.difference_p, '.2g')}, "
-                f"{row.n_pairs} pairs)"
-            )
         cells = [
             row.label,
             str(row.n_trials),
             _percent(row.study_competence),
             *(_shares(row, region) for region in STUDY_REGIONS),
-            competence,
-            _percent(row.words_within),
+            *(ablation_tests.cell(m, row.measures[m.name]) for m in measures),
+            *(ablation_tests.within_cell(row.measures[m.name]) for m in gaps),
             f"{_number(row.median_names, '.2f')} / {_number(row.median_distractors, '.2f')}",
-            _number(row.names_vs_distractors_p_two_sided, ".2g"),
+            _number(row.pooled_names_vs_distractors_p_two_sided, ".2g"),
         ]
         lines.append("| " + " | ".join(cells) + " |")
+    made, kept = ablation_tests.count_tests([row.measures for row in rows])
+    lines.append("")
+    lines.append(
+        f"{made} tests over trials; {kept} survive Holm's correction for that number "
+        f"(family-wise α = {ALPHA:g}), marked in their cells. The last column pools the words of "
+        "every trial and is not counted."
+    )
     return "\n".join(lines) + "\n"
 
 
 def csv_table(rows: list[AblationRow]) -> pd.DataFrame:
-    """Every number of the rows, one column each (strategy shares flattened)."""
+    """Every number of the rows, one column each (strategy shares and measures flattened:
+    `<measure>_<number>`)."""
     records = []
     for row in rows:
         record = asdict(row)
         shares = record.pop("study_strategies")
+        for name, numbers in record.pop("measures").items():
+            record.update({f"{name}_{k}": v for k, v in numbers.items()})
         for region in STUDY_REGIONS:
             for strategy in STRATEGIES:
                 record[f"study_{region}_{strategy}"] = shares.get(region, {}).get(
@@ -277,13 +289,14 @@ def ablation_figure(rows: list[AblationRow]) -> Figure:
     y = list(range(len(rows)))[::-1]
     _draw_paper(middle, right)
     for yi, row in zip(y, rows, strict=True):
-        if math.isfinite(row.difference):
+        competence = row.measures.get(COMPETENCE)
+        if competence is not None and math.isfinite(competence.difference):
             left.errorbar(
-                100 * row.difference,
+                100 * competence.difference,
                 yi,
                 xerr=[
-                    [100 * (row.difference - row.difference_low)],
-                    [100 * (row.difference_high - row.difference)],
+                    [100 * (competence.difference - competence.low)],
+                    [100 * (competence.high - competence.difference)],
                 ],
                 fmt="o",
                 color="black",
@@ -335,8 +348,8 @@ def write_ablations(
     """Compute the rows, then write the CSV, the figure and the table into out_dir as one unit
     (after everything was computed; a failed write leaves nothing). Returns the table's path."""
     check_out_dir(Path(out_dir))
-    rows = ablation_rows(baseline_dir, batch_dirs, measures)
-    table = markdown_table(rows)
+    rows, columns = _rows_and_measures(baseline_dir, batch_dirs, measures)
+    table = markdown_table(rows, columns)
     figure = png_bytes(ablation_figure(rows))
     csv = csv_table(rows).to_csv(index=False)
     files = {

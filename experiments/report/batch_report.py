@@ -21,6 +21,7 @@ from experiments.analysis.stats import summarise_batch
 from experiments.file_names import REPORT_FILE
 from experiments.report import intro, name_strategies, paper, tool_rule
 from experiments.report.figures import FigureFile, report_figures
+from experiments.report.measures import registry
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
 from experiments.report.summary import page_summary, summary_files
@@ -69,6 +70,7 @@ def write_report(
         page=REPORT_FILE,
         batches=[str(results.batch_dir)],
         computed_on=computed_on,
+        registry=registry(geometry),
     )
     return write_page(out, figures, REPORT_FILE, page, beside=summary_files(content))
 

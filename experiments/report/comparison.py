@@ -7,39 +7,20 @@ grasping run apart), or one batch of exactly two groups compared with itself.
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
-from scipy import stats
 
 from experiments import provenance
 from experiments.analysis.geometry import Geometry
-from experiments.analysis.results import (
-    COMPETENCE_SCOPES,
-    BatchResults,
-    ReportError,
-    check_out_dir,
-    collect,
-)
+from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
-from experiments.analysis.stats import (
-    STRATEGIES,
-    chi_square,
-    competence_summary,
-    cost_per_iteration,
-    mann_whitney,
-    regions,
-    strategy_counts,
-    strategy_table,
-    welch,
-)
+from experiments.analysis.trial_tests import ALPHA
 from experiments.file_names import COMPARISON_FILE
 from experiments.report import (
+    differences,
     intro,
-    mechanisms,
     name_strategies,
     paper,
     strategy_definitions,
@@ -47,16 +28,13 @@ from experiments.report import (
 )
 from experiments.report.batch_report import numbers_and_figures
 from experiments.report.figures import FigureFile
+from experiments.report.measures import registry
 from experiments.report.mechanism_figures import mechanism_figures
 from experiments.report.pages import (
     Table,
-    ci_text,
-    num,
-    p_value,
     pct,
     render,
     settings_table,
-    shares_text,
     trials_table,
     where_table,
     write_page,
@@ -90,92 +68,6 @@ def _sides(dir_a: Path, dir_b: Path) -> tuple[BatchResults, BatchResults]:
     return a, b
 
 
-def _per_iteration(cost: float) -> str:
-    """Seconds per iteration as milliseconds, or why there is no number."""
-    return "not recorded" if not np.isfinite(cost) else f"{1000 * cost:.2f} ms / iteration"
-
-
-def _competence_rows(a: BatchResults, b: BatchResults) -> list[list[str]]:
-    """Per scope: both sides' mean and interval, Welch's t test on the per-trial values."""
-    rows = []
-    summary = competence_summary(pd.concat([a.trials, b.trials]))
-    for scope in COMPETENCE_SCOPES:
-        values = [side.trials[f"competence_{scope}"].to_numpy() for side in (a, b)]
-        texts = [
-            ci_text(
-                summary[(summary["group"] == s.groups[0]) & (summary["scope"] == scope)].iloc[0]
-            )
-            for s in (a, b)
-        ]
-        name = "all rings" if scope == "all" else scope.replace("ring", "ring ")
-        rows.append(
-            [
-                f"Normalised competence, {name}",
-                *texts,
-                "Welch t (per-trial values)",
-                p_value(welch(*values)[1]),
-            ]
-        )
-    return rows
-
-
-def _strategy_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list[list[str]]:
-    """Per region: both sides' shares, χ² test of groups × strategies on pooled counts."""
-    rows = []
-    tests = pd.concat([a.competence, b.competence])
-    counts = strategy_counts(tests, geometry.hand_limit, geometry.stick_limit)
-    shares = strategy_table(tests, geometry.hand_limit, geometry.stick_limit)
-    for region in regions(geometry.hand_limit, geometry.stick_limit):
-        table = counts[counts["region"] == region]
-        texts = [
-            shares_text(
-                shares[(shares["group"] == s.groups[0]) & (shares["region"] == region)].iloc[0]
-            )
-            for s in (a, b)
-        ]
-        matrix = table.set_index("group").loc[[a.groups[0], b.groups[0]], list(STRATEGIES)]
-        rows.append(
-            [
-                f"Strategy hand / tool / vocal, {region}",
-                *texts,
-                "χ² (pooled tests, groups × strategies)",
-                p_value(chi_square(matrix.to_numpy())[1]),
-            ]
-        )
-    return rows
-
-
-# Per-trial stick numbers (experiments/analysis/curves.py): (column, statistic, how to show it).
-STICK_NUMBERS = (
-    ("stick_in_reach", "Iterations that began with the stick within reach", pct),
-    ("stick_grasps_per_1000_arm", "Stick grasps per 1000 arm movements", num),
-    ("toy_catches_per_1000_arm", "Toys caught with the stick per 1000 arm movements", num),
-    ("stick_returns", "Stick returns by the experimenter per trial", num),
-)
-
-
-def _stick_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list[list[str]]:
-    """The stick as a tool: per-trial numbers (Welch), the tool tests split into stick held
-    and stick only pushed (χ²), and how often random commands grasp it from its start."""
-    rows = []
-    for column, name, shown in STICK_NUMBERS:
-        values = [s.trials[column].to_numpy(dtype=float) for s in (a, b)]
-        if any(np.isnan(v).all() for v in values):
-            continue  # logs written before the column existed
-        texts = [f"{shown(np.nanmean(v))} (n={len(v)})" for v in values]
-        rows.append([name, *texts, "Welch t (per-trial values)", p_value(welch(*values)[1])])
-    tools = [s.competence[s.competence["strategy"] == "tool"] for s in (a, b)]
-    if all("stick_grasped" in t.columns for t in tools):
-        held = [int(t["stick_grasped"].sum()) for t in tools]
-        pushed = [len(t) - h for t, h in zip(tools, held, strict=True)]
-        texts = [f"{h} / {p}" for h, p in zip(held, pushed, strict=True)]
-        p = chi_square(np.array([held, pushed]).T)[1]
-        rows.append(
-            ["Tool tests: stick held / only pushed", *texts, "χ² (pooled tests)", p_value(p)]
-        )
-    return rows
-
-
 def _grasp_rate_row(
     a: BatchResults, b: BatchResults, n_commands: int, measures: RoomMeasures
 ) -> list[list[str]]:
@@ -187,84 +79,52 @@ def _grasp_rate_row(
         return []
     rates = measures.grasp_rates(n_commands, tuple(grasps))
     texts = [f"{pct(rates[g], 1)} of {n_commands}" for g in grasps]
-    return [["Random arm commands that grasp the stick at its start", *texts, "same commands", ""]]
+    # The same commands played in both rooms: a property of the rooms, not a sample of agents.
+    test = "not tested: the same commands in both rooms, not a sample of trials"
+    return [["Random arm commands that grasp the stick at its start", *texts, test, ""]]
 
 
-def _vocal_rows(a: BatchResults, b: BatchResults, threshold: float) -> list[list[str]]:
-    """Share of words within the threshold (Fisher exact) and median best distances
-    (Mann-Whitney U), on the words of every trial pooled."""
-    below = [(s.vocal["best_distance"] < threshold).sum() for s in (a, b)]
-    total = [len(s.vocal) for s in (a, b)]
-    table = np.array([[below[0], total[0] - below[0]], [below[1], total[1] - below[1]]])
-    fisher = stats.fisher_exact(table)
-    rows = [
-        [
-            f"Words imitated within {threshold:g}",
-            *[f"{pct(n / m if m else math.nan)} of {m}" for n, m in zip(below, total, strict=True)],
-            "Fisher exact (pooled words)",
-            p_value(float(fisher.pvalue)),
-        ]
-    ]
-    for label, pick in (
-        ("all words", lambda v: v),
-        ("toy names", lambda v: v[v["is_name"]]),
-        ("distractors", lambda v: v[~v["is_name"]]),
-    ):
-        values = [pick(s.vocal)["best_distance"].to_numpy(dtype=float) for s in (a, b)]
-        rows.append(
-            [
-                f"Best word distance, {label} (median)",
-                *[f"{num(np.median(v)) if len(v) else 'n/a'} (n={len(v)})" for v in values],
-                "Mann-Whitney U (pooled words)",
-                p_value(mann_whitney(*values)[1]),
-            ]
-        )
-    return rows
-
-
-def _cost_rows(a: BatchResults, b: BatchResults) -> list[list[str]]:
-    """Diverged iterations (χ² on pooled iterations) and compute cost per iteration."""
-    diverged = [int(s.trials["diverged"].sum()) for s in (a, b)]
-    iterations = [int(s.trials["iterations"].sum()) for s in (a, b)]
-    pairs = list(zip(diverged, iterations, strict=True))
-    costs = [cost_per_iteration(s.trials) for s in (a, b)]
-    ratio = costs[1] / costs[0] if all(np.isfinite(costs)) and costs[0] > 0 else math.nan
-    return [
-        [
-            "Iterations whose physics diverged",
-            *[f"{d} of {n}" for d, n in pairs],
-            "χ² (pooled iterations)",
-            p_value(chi_square(np.array([[d, n - d] for d, n in pairs]))[1]),
-        ],
-        [
-            "Cost per iteration (timing.json: trial seconds / iterations)",
-            *[_per_iteration(c) for c in costs],
-            f"ratio {b.groups[0]} / {a.groups[0]}",
-            "n/a" if not np.isfinite(ratio) else f"{ratio:.2f}×",
-        ],
-    ]
-
-
-def difference_rows(
+def difference_table(
     a: BatchResults,
     b: BatchResults,
     geometry: Geometry,
-    measures: RoomMeasures,
+    room: RoomMeasures,
     grasp_rate_commands: int = GRASP_RATE_COMMANDS,
-) -> list[list[str]]:
-    """[statistic, A, B, test, p] rows: is the difference between the two groups real?
-    `a`, `b`: one group each."""
-    return [
-        *_competence_rows(a, b),
-        *_strategy_rows(a, b, geometry),
-        *strategy_definitions.comparison_rows(a, b, geometry),
-        *_vocal_rows(a, b, geometry.threshold),
-        *_stick_rows(a, b, geometry),
-        *tool_rule.comparison_rows(a, b),
-        *_grasp_rate_row(a, b, grasp_rate_commands, measures),
-        *_cost_rows(a, b),
-        *mechanisms.comparison_rows(a, b),
+) -> tuple[Table, list[differences.Evaluated]]:
+    """The table of differences: every measure of the registry (experiments/report/
+    measures.py) tested over trials (experiments/report/differences.py), then the random
+    commands' grasp rates (the same commands in both rooms: not a sample of trials, not
+    tested). `a`, `b`: one group each. Returns the table and the evaluated measures."""
+    evaluated = differences.evaluate(registry(geometry), a, b)
+    tested = sum(np.isfinite(o.test.p) for e in evaluated for o in e.outcomes)
+    header = [
+        "measure (mean over trials [95% t interval])",
+        a.groups[0],
+        b.groups[0],
+        "test over trials",
+        "p (two-sided)",
+        f"survives Holm ({tested} tests, α = {ALPHA:g})",
     ]
+    rows = differences.rows(evaluated, a, b)
+    rows += [[*r, ""] for r in _grasp_rate_row(a, b, grasp_rate_commands, room)]
+    return Table(header, rows), evaluated
+
+
+def tests_note(evaluated: list[differences.Evaluated]) -> str:
+    """The sentence under the table: how many tests it makes and how many survive Holm."""
+    summary = differences.tests_summary(evaluated)
+    # The tests of the two sides (not those of one side's gap against 0) pair or do not.
+    paired = [t["paired"] for t in summary["tests"] if len(t["n"]) == 2]
+    how = (
+        "paired over seeds (both sides hold the same seeds)"
+        if paired and all(paired)
+        else "Welch's t (the sides do not hold the same seeds, so they do not pair)"
+    )
+    return (
+        f"This table makes {summary['count']} tests on per-trial values, {how}; "
+        f"{summary['survive']} of them survive Holm's correction for that number "
+        f"(family-wise α = {ALPHA:g})."
+    )
 
 
 def write_comparison(
@@ -291,10 +151,7 @@ def write_comparison(
     g = merged.groups
     computed_on = provenance.short_record(provenance.machine_record())  # this page's machine
     where, where_note = where_table(merged, computed_on)
-    tests = Table(
-        ["statistic", g[0], g[1], "test of the difference", "p (two-sided)"],
-        difference_rows(a, b, geometry, measures, grasp_rate_commands),
-    )
+    tests, evaluated = difference_table(a, b, geometry, measures, grasp_rate_commands)
     page = render(
         "comparison.html.j2",
         title=f"Playroom comparison: {g[0]} vs {g[1]}",
@@ -306,6 +163,7 @@ def write_comparison(
         settings=settings_table(merged),
         configs=merged.configs,
         tests=tests,
+        tests_note=tests_note(evaluated),
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),
         paper=published,
         reference=paper.reference(),
@@ -324,6 +182,8 @@ def write_comparison(
         batches=[str(d) for d in dict.fromkeys((dir_a, dir_b))],
         computed_on=computed_on,
         tests=tests,
+        evaluated=evaluated,
+        registry=registry(geometry),
     )
     # Both definitions of "tool", with intervals over trials (issue 32: like with like).
     for group, numbers_of in strategy_definitions.summary_numbers(merged, geometry).items():

@@ -39,6 +39,11 @@ class Table:
 TRACT_NAMES = {"vtl": "VocalTractLab", "diva": "DIVA (the study's)"}
 
 
+# Below this a p-value has underflowed in its computation (a t or χ² far in the tail): printed
+# as this bound (the smallest normal double is 2.2e-308; a round bound above it).
+P_FLOOR = 1e-300
+
+
 def pct(x: float, digits: int = 0) -> str:
     """A fraction as a percentage ("46%"); "n/a" for NaN or inf."""
     return "n/a" if not np.isfinite(x) else f"{100 * x:.{digits}f}%"
@@ -50,10 +55,14 @@ def num(x: float, digits: int = 2) -> str:
 
 
 def p_value(p: float) -> str:
-    """A p value as text: 3 decimals, or 2 significant digits below 0.001 (not "0.000")."""
+    """A p value as text, with 2 significant digits ("p = 0.063", "p = 1.4e-17"); a p that
+    underflowed (0, or below the float range's normal numbers, where its digits are lost) as
+    a bound, "p < 1e-300", never as 0."""
     if not np.isfinite(p):
         return "n/a"
-    return f"p = {p:.3f}" if p >= 1e-3 else f"p = {p:.1e}"
+    if p < P_FLOOR:
+        return f"p < {P_FLOOR:.0e}"
+    return f"p = {p:.2g}" if p >= 1e-3 else f"p = {p:.1e}"
 
 
 # Below this many trials a group's t interval rests on too few values to trust: the pages say

@@ -154,7 +154,8 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
         ],
         [
             "Mann-Whitney U, names vs distractors "
-            "(two-sided p: the one-sided p doubled, as the study did)",
+            "(two-sided p: the one-sided p doubled, as the study did; on the words of all "
+            "trials pooled, as the study did, so treating words as independent)",
             paper["mann_whitney_p"].cell,
             *[f"U = {num(vocal[x]['u'], 1)}, {p_value(vocal[x]['p'])}" for x in g],
         ],

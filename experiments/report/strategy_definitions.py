@@ -1,20 +1,18 @@
 """The strategy shares of a comparison under both definitions of "tool" (the study's: the stick
 moved; and the stick held), for the project's tests and the study's, with intervals over
-trials (experiments/analysis/strategies.py): rows of the comparison's table of differences and
-`strategy_definitions` in summary.json."""
+trials (experiments/analysis/strategies.py): `strategy_definitions` in summary.json. The rows
+of the comparison's table of differences are measures of experiments/report/measures.py."""
 
 from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults
-from experiments.analysis.stats import STRATEGIES, chi_square, regions
-from experiments.analysis.strategies import DEFINITIONS, both_definitions, contact_counts
-from experiments.report.pages import p_value, pct
+from experiments.analysis.stats import regions
+from experiments.analysis.strategies import both_definitions, contact_counts
 
 # The two sets of tests each trial holds: the project's measure (every test from the same
 # scene) and the study's (the scene carried over), named as the pages name them.
@@ -31,50 +29,6 @@ def shares(results: BatchResults, geometry: Geometry) -> pd.DataFrame:
             continue
         tables.append(both_definitions(tests, areas).assign(measure=measure))
     return pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
-
-
-def _text(rows: pd.DataFrame) -> str:
-    """ "hand / tool / vocal" shares, each with its interval, and the counts behind them."""
-    if rows.empty or rows["n_tests"].iloc[0] == 0:
-        return "no tests here"
-    parts = []
-    for strategy in STRATEGIES:
-        r = rows[rows["strategy"] == strategy].iloc[0]
-        interval = "" if not np.isfinite(r["low"]) else f" [{pct(r['low'])}, {pct(r['high'])}]"
-        parts.append(f"{strategy} {pct(r['mean'])}{interval}")
-    first = rows.iloc[0]
-    return f"{', '.join(parts)} (n={first['n_trials']} trials, {first['n_tests']} tests)"
-
-
-def comparison_rows(a: BatchResults, b: BatchResults, geometry: Geometry) -> list[list[str]]:
-    """Per measure, definition and region: each side's shares with intervals over trials, and
-    the χ² test of sides x strategies on the pooled test counts."""
-    table = shares(a.merge(b), geometry)
-    if table.empty:
-        return []
-    out = []
-    for (measure, definition, region), rows in table.groupby(
-        ["measure", "definition", "region"], sort=False
-    ):
-        sides = [rows[rows["group"] == s.groups[0]] for s in (a, b)]
-        if any(side.empty for side in sides):
-            continue
-        counts = np.array(
-            [
-                [side.loc[side["strategy"] == s, "count"].iloc[0] for s in STRATEGIES]
-                for side in sides
-            ]
-        )
-        label = "project's tests" if measure == "project" else "study's tests"
-        out.append(
-            [
-                f"Strategies ({label}; {DEFINITIONS[str(definition)]}), {region}",
-                *[_text(side) for side in sides],
-                "intervals over trials; χ² (pooled tests, sides × strategies)",
-                p_value(chi_square(counts)[1]),
-            ]
-        )
-    return out
 
 
 def summary_numbers(results: BatchResults, geometry: Geometry) -> dict[str, Any]:

@@ -20,8 +20,14 @@ summary.json:
 - trials: one record per trial (its competence per scope, vocal numbers, diverged iterations,
   stick numbers, seconds and timed iterations);
 - paper: the paper's published numbers beside them (value, text, runs, source);
+- measures: each measure of the registry (experiments/report/measures.py) the batch recorded:
+  label, kind, parts, how it is tested, and `per_trial`, its value per trial as columns
+  (trial, group, seed, one list of numbers per part);
 - comparison pages only: `tests`, the page's table of differences as it shows it, text:
-  columns (statistic, each side's group, the test, its p) and rows.
+  columns (measure, each side's group, the test, its p, Holm) and rows; `trial_tests`, every
+  test of it over trials (measure, part, method, statistic, difference, p, n per group,
+  paired, Holm-adjusted p, survives; with the correction, alpha, count and survivors), the
+  pooled second lines (`pooled`) and the parts not tested and why (`not_tested`).
 
 summary.csv holds the per-group numbers as one long table, a row per number: group, measure
 ("project" or "study"), statistic, scope (ring or region, or empty), value, low, high, n.
@@ -41,6 +47,8 @@ from experiments.analysis.mechanisms import LABELS
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
 from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
+from experiments.report.differences import Evaluated, per_trial_values, tests_summary
+from experiments.report.measures import Measure
 from experiments.report.pages import Table
 from experiments.report.paper import PaperNumber
 
@@ -118,10 +126,13 @@ def page_summary(
     page: str,
     batches: list[str],
     computed_on: dict[str, str] | None,
+    registry: tuple[Measure, ...],
     tests: Table | None = None,
+    evaluated: list[Evaluated] | None = None,
 ) -> dict[str, Any]:
     """The summary of a page (module docstring), JSON-ready but for NaN and inf.
-    `numbers`: what batch_report.numbers_and_figures computed for the page."""
+    `numbers`: what batch_report.numbers_and_figures computed for the page; `registry`: the
+    measures whose per-trial values it holds; `evaluated`: a comparison's tests of them."""
     out: dict[str, Any] = {
         "page": page,
         "batches": batches,
@@ -130,9 +141,12 @@ def page_summary(
         "by_group": {g: _group_numbers(results, numbers, g) for g in results.groups},
         "trials": _trial_records(results),
         "paper": _paper(published),
+        "measures": per_trial_values(registry, results),
     }
     if tests is not None:
         out["tests"] = {"columns": tests.header, "rows": tests.rows}
+    if evaluated is not None:
+        out["trial_tests"] = tests_summary(evaluated)
     return out
 
 

@@ -5,18 +5,17 @@ the last sample of the movement (experiments/measure/study_measure.py). With con
 physical stick is nudged by fractions of a millimetre that no one would call tool use; the
 pages keep the study's rule as the measure and show beside it how many of its tool uses moved
 the stick less than `TOOL_MIN_MOTION`, and the tool share without them
-(experiments/analysis/stats.py, `tool_motion`).
+(experiments/analysis/stats.py, `tool_motion`). The comparison's rows of these numbers, per
+trial and tested over trials, are measures of experiments/report/measures.py.
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from experiments.analysis.results import BatchResults
-from experiments.analysis.stats import TOOL_MIN_MOTION, chi_square, tool_motion
-from experiments.report.pages import Table, p_value, pct
+from experiments.analysis.stats import TOOL_MIN_MOTION, tool_motion
+from experiments.report.pages import Table, pct
 
 NOT_RECORDED = (
     "not recorded: trials evaluated before the study's tests kept the stick's motion; "
@@ -67,40 +66,3 @@ def page_context(results: BatchResults) -> dict:
         "tool_min_motion": _minimum_text(TOOL_MIN_MOTION),
         "tool_motion_note": NOT_RECORDED,
     }
-
-
-def comparison_rows(
-    a: BatchResults, b: BatchResults, min_motion: float = TOOL_MIN_MOTION
-) -> list[list[str]]:
-    """[statistic, A, B, test, p] rows of the comparison: the study's tool uses that moved the
-    stick less than `min_motion`, and the tool share of the study's tests with that minimum
-    (χ² on pooled tests). None of them when a side has no study tests."""
-    if a.study_tests.empty or b.study_tests.empty:
-        return []
-    sides = [tool_motion(s.study_tests, min_motion).iloc[0].to_dict() for s in (a, b)]
-    minimum = _minimum_text(min_motion)
-    recorded = not any(math.isnan(s["small"]) for s in sides)
-    small = np.array([[s["small"], s["tool"] - s["small"]] for s in sides]) if recorded else None
-    kept = (
-        np.array([[s["tool"] - s["small"], s["tests"] - s["tool"] + s["small"]] for s in sides])
-        if recorded
-        else None
-    )
-    test = "χ² (pooled tests)"
-    return [
-        [
-            f"Study's tool uses that moved the stick's x less than {minimum}",
-            *[_small_text(s) for s in sides],
-            test,
-            p_value(chi_square(small)[1]) if small is not None else "n/a",
-        ],
-        [
-            f"Study's tests: tool share, its rule / with at least {minimum}",
-            *[
-                f"{pct(s['tool_share'], 1)} / {pct(s['tool_share_min_motion'], 1)} (n={s['tests']})"
-                for s in sides
-            ],
-            f"{test}, with at least {minimum}",
-            p_value(chi_square(kept)[1]) if kept is not None else "n/a",
-        ],
-    ]

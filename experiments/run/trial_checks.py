@@ -94,13 +94,20 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
         )
     if meta["iteration"] == 0:
         raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
+    if check_files(trial_dir, meta, config) is None:
+        manifest.warn_unchecked(trial_dir)
+    return config, agent, room, meta
+
+
+def check_files(trial_dir: Path, meta: dict, config: dict) -> manifest.Manifest | None:
+    """TrialError unless the logs and backend.json of the trial whose checkpoint has metadata
+    `meta` are whole and as its manifest recorded them (the memory segments are checked when the
+    checkpoint is restored); the manifest, None for a trial from before manifests."""
     recorded = _recorded(trial_dir, meta)
     check_logs(trial_dir, int(meta["iteration"]), config, recorded)
-    if recorded is None:
-        manifest.warn_unchecked(trial_dir)
-    else:
+    if recorded is not None:
         _check_backend(trial_dir, recorded)
-    return config, agent, room, meta
+    return recorded
 
 
 def _recorded(trial_dir: Path, meta: dict) -> manifest.Manifest | None:

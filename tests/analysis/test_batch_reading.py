@@ -35,9 +35,10 @@ def _report(capsys, batch) -> tuple[int, list[str]]:
     return code, capsys.readouterr().err.strip().splitlines()
 
 
-def test_the_intact_batch_reads_and_reports(batch, capsys):
+def test_the_intact_batch_reads(batch):
+    # (Its report, with every check, is tests/report/test_report.py's on the same batches.)
     assert len(read_batch_logs(batch)) == 600
-    assert _report(capsys, batch)[0] == 0
+    assert len(read_batch_logs(batch, "words")) == 6
 
 
 def test_d3_a_missing_chunk_stops_the_batch_readers(batch, capsys):

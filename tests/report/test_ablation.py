@@ -57,6 +57,17 @@ def _competence(batch: Path) -> dict[int, float]:
     return out
 
 
+def _gaps(batch: Path) -> dict[int, float]:
+    """Each trial's median best distance of its distractors minus its names', per seed."""
+    out = {}
+    for trial in batch.glob("*-seed*"):
+        seed = json.loads((trial / "config.json").read_text())["trial"]["seed"]
+        vocal = pd.read_parquet(trial / "vocal.parquet")
+        medians = vocal.groupby("is_name")["best_distance"].median()
+        out[seed] = medians[False] - medians[True]
+    return out
+
+
 def test_rows_are_paired_by_seed_and_named_by_the_changed_setting(batches, sigma_batch, tmp_path):
     base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
     rows = ablation_rows(batches["kinematic"], [sigma_batch], room_measures(COMMANDS))
@@ -65,15 +76,24 @@ def test_rows_are_paired_by_seed_and_named_by_the_changed_setting(batches, sigma
         "learner.exploration_sigma: 0.1 -> 0.05",
     ]
     baseline, row = rows
-    assert baseline.n_trials == row.n_trials == row.n_pairs == 2
-    assert math.isnan(baseline.difference)
+    competence = row.measures["competence_all"]
+    assert baseline.n_trials == row.n_trials == competence.n_pairs == 2
+    assert math.isnan(baseline.measures["competence_all"].difference)
     differences = [ablated[s] - base[s] for s in (0, 1)]
-    assert row.difference == pytest.approx(np.mean(differences))
-    assert row.competence == pytest.approx(np.mean(list(ablated.values())))
+    assert competence.difference == pytest.approx(np.mean(differences))
+    assert competence.mean == pytest.approx(np.mean(list(ablated.values())))
     vocal = pd.concat(pd.read_parquet(t / "vocal.parquet") for t in sigma_batch.glob("*-seed*"))
-    assert row.words_within == pytest.approx((vocal["best_distance"] < 0.4).mean())
+    # Each trial's share of its words, averaged over trials (6 words each: the pooled share).
+    within = (vocal["best_distance"] < 0.4).mean()
+    assert row.measures["words_within"].mean == pytest.approx(within)
     names = vocal.loc[vocal["is_name"], "best_distance"]
     assert row.median_names == pytest.approx(np.median(names))
+    # Each trial's gap, distractors' median minus names', against the baseline's on its seed.
+    assert set(row.measures) == {"competence_all", "words_within", "names_vs_distractors"}
+    gap, gap_base = _gaps(sigma_batch), _gaps(batches["kinematic"])
+    names_gap = row.measures["names_vs_distractors"]
+    assert names_gap.mean == pytest.approx(np.mean(list(gap.values())))
+    assert names_gap.difference == pytest.approx(np.mean([gap[s] - gap_base[s] for s in (0, 1)]))
     assert 0.0 <= row.study_competence <= 1.0
     assert set(row.study_strategies) == {"centre", "between_limits", "distance_1"}
 
@@ -82,11 +102,12 @@ def test_the_baseline_keeps_only_the_seeds_the_ablations_hold(batches, sigma_bat
     one_seed = tmp_path / "seed1"
     shutil.copytree(sigma_batch / "kinematic-random-seed0001", one_seed / "k-seed0001")
     baseline, row = ablation_rows(batches["kinematic"], [one_seed], room_measures(COMMANDS))
-    assert baseline.n_trials == row.n_trials == row.n_pairs == 1
+    competence = row.measures["competence_all"]
+    assert baseline.n_trials == row.n_trials == competence.n_pairs == 1
     base, ablated = _competence(batches["kinematic"]), _competence(sigma_batch)
-    assert baseline.competence == pytest.approx(base[1])
-    assert row.difference == pytest.approx(ablated[1] - base[1])
-    assert math.isnan(row.difference_p)  # one pair: no test
+    assert baseline.measures["competence_all"].mean == pytest.approx(base[1])
+    assert competence.difference == pytest.approx(ablated[1] - base[1])
+    assert math.isnan(competence.p) and math.isnan(competence.holm_p)  # one pair: no test
 
 
 def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
@@ -95,10 +116,13 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
     )
     assert table.name == ABLATION_TABLE_FILE
     lines = table.read_text().splitlines()
-    assert len(lines) == 4 and "learner.exploration_sigma: 0.1 -> 0.05" in lines[3]
+    assert len(lines) == 6 and "learner.exploration_sigma: 0.1 -> 0.05" in lines[3]
+    assert "survive Holm's correction" in lines[5]
     csv = pd.read_csv(tmp_path / "out" / ABLATION_CSV_FILE)
     assert list(csv["n_trials"]) == [2, 2]
-    assert {"difference", "difference_p", "study_distance_1_vocal"} <= set(csv.columns)
+    columns = {"competence_all_difference", "competence_all_p", "competence_all_holm_p"}
+    columns |= {"names_vs_distractors_within_p", "study_distance_1_vocal"}
+    assert columns <= set(csv.columns)
     # The names effect's p: the study's convention, named in the column and the header.
     vocal = pd.concat(pd.read_parquet(t / "vocal.parquet") for t in sigma_batch.glob("*-seed*"))
     names, distractors = (vocal.loc[vocal["is_name"] == s, "best_distance"] for s in (True, False))
@@ -106,8 +130,9 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
         stats.mannwhitneyu(names, distractors, alternative=side).pvalue
         for side in ("less", "greater")
     )
-    assert csv["names_vs_distractors_p_two_sided"].iloc[1] == pytest.approx(min(1, 2 * one_sided))
-    assert "names vs distractors, Mann-Whitney two-sided p (one-sided doubled" in lines[0]
+    p = csv["pooled_names_vs_distractors_p_two_sided"].iloc[1]
+    assert p == pytest.approx(min(1, 2 * one_sided))
+    assert "Mann-Whitney two-sided p, one-sided doubled as the study" in lines[0]
     assert (tmp_path / "out" / ABLATION_FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
 
 

@@ -8,7 +8,8 @@ import pandas as pd
 
 from experiments.analysis.geometry import Geometry
 from experiments.report import paper
-from experiments.report.ablations import STUDY_REGIONS, AblationRow, ablation_figure
+from experiments.report.ablation_tests import AblationNumbers
+from experiments.report.ablations import COMPETENCE, STUDY_REGIONS, AblationRow, ablation_figure
 from experiments.report.intro import rings_text
 from experiments.report.pages import ci_text
 
@@ -69,10 +70,10 @@ def test_figure_axes_start_at_zero_and_carry_units():
 
 def _ablation_row(label: str, difference: float) -> AblationRow:
     shares = {r: {"hand": 0.5, "tool": 0.2, "vocal": 0.3} for r in STUDY_REGIONS}
+    competence = AblationNumbers(0.3, 4, difference, difference - 0.05, difference + 0.05, 0.2, 4)
     return AblationRow(
-        label, "batch", "kinematic", 4, 0.4, shares, 0.3, difference, difference - 0.05,
-        difference + 0.05, 0.2, 4, 0.8, 0.25, 0.31, 0.01,
-    )  # fmt: skip
+        label, "batch", "kinematic", 4, 0.4, shares, {COMPETENCE: competence}, 0.25, 0.31, 0.01
+    )
 
 
 def test_the_ablation_figure_is_titled_in_words_with_the_papers_values():

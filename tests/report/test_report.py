@@ -117,10 +117,10 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
         "Iterations that began with the stick within reach",
         "Stick grasps per 1000 arm movements",
         "Stick returns by the experimenter per trial",
-        "Tool tests: stick held / only pushed",
+        "Tool tests (study&#39;s rule) in which the stick was only pushed",  # escaped
         "Random arm commands that grasp the stick at its start",
         # The study's tool rule beside a minimum motion (tests/report/test_tool_rule.py).
-        "tool uses that moved the stick",  # the page escapes the apostrophes
+        "tests: tool share, its rule / with at least 1 mm",  # the page escapes the apostrophes
         "<h2>Tool use and a minimum motion</h2>",
     ):
         assert statistic in text, statistic
@@ -133,6 +133,22 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     assert summary["groups"] == ["kinematic", "physical"]
     assert [t["seed"] for t in summary["trials"]] == [0, 1, 0]
     assert summary["tests"]["rows"][0][0] == "Normalised competence, all rings"
+    # Seeds 0, 1 against seed 0 do not pair: Welch's t over trials, each test in trial_tests.
+    tests = summary["trial_tests"]
+    assert tests["correction"] == "Holm" and tests["tests"]
+    assert {t["method"] for t in tests["tests"]} <= {"Welch t", "one-sample t against 0"}
+    assert not any(t["paired"] for t in tests["tests"])
+    competence = next(t for t in tests["tests"] if t["measure"] == "competence_all")
+    assert competence["n"] == {"kinematic": 2, "physical": 1} and not competence["paired"]
+    assert f"This table makes {tests['count']} tests on per-trial values" in text
+    # Each measure's value per trial, with its seed.
+    per_trial = summary["measures"]["competence_all"]["per_trial"]
+    assert list(zip(per_trial["group"], per_trial["seed"], strict=True)) == [
+        ("kinematic", 0),
+        ("kinematic", 1),
+        ("physical", 0),
+    ]
+    assert per_trial["value"] == [t["competence_all"] for t in summary["trials"]]
 
 
 # Report numbers on hand-made tables ------------------------------------------------------------

@@ -10,9 +10,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from experiments.analysis import trial_values
 from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import TOOL_MIN_MOTION, tool_motion
-from experiments.report.tool_rule import comparison_rows, tool_motion_table
+from experiments.report import differences, measure_notes
+from experiments.report.measures import tool_rule_measures
+from experiments.report.tool_rule import tool_motion_table
 
 
 def _tests(group: str, dx: list[float], hands: int, vocal: int) -> pd.DataFrame:
@@ -21,6 +24,8 @@ def _tests(group: str, dx: list[float], hands: int, vocal: int) -> pd.DataFrame:
     return pd.DataFrame(
         {
             "group": group,
+            "trial": f"{group}-seed0",
+            "seed": 0,
             "strategy": strategies,
             "stick_dx": [*dx, *[0.0] * (hands + vocal)],
         }
@@ -28,11 +33,13 @@ def _tests(group: str, dx: list[float], hands: int, vocal: int) -> pd.DataFrame:
 
 
 def _results(tests: pd.DataFrame) -> BatchResults:
+    """One trial per group, holding the group's tests."""
     groups = list(dict.fromkeys(tests["group"]))
     empty = pd.DataFrame(columns=["group", "seed"])
+    trials = tests[["trial", "group", "seed"]].drop_duplicates().reset_index(drop=True)
     return BatchResults(
         batch_dir=Path("."),
-        trials=empty,
+        trials=trials,
         competence=empty,
         vocal=empty,
         curves=empty,
@@ -72,7 +79,7 @@ def test_tests_without_the_stick_motion_are_not_recorded_not_zero():
     assert math.isnan(tool_motion(mixed).iloc[0]["small"])
 
 
-def test_the_pages_table_and_the_comparisons_rows():
+def test_the_pages_table_and_each_trials_shares():
     results = _results(pd.concat([PHYSICAL, KINEMATIC], ignore_index=True))
     table = tool_motion_table(results)
     assert table is not None
@@ -80,21 +87,27 @@ def test_the_pages_table_and_the_comparisons_rows():
     assert rows["physical"][1:] == ["10", "5", "3 of 5", "50.0%", "20.0%"]
     assert rows["kinematic"][1:] == ["10", "4", "1 of 4", "40.0%", "30.0%"]
     assert "1 mm" in table.header[3]
-    small, share = comparison_rows(results.select("physical"), results.select("kinematic"))
-    assert small[1:3] == ["3 of 5", "1 of 4"] and small[4].startswith("p = ")
-    assert share[1:3] == ["50.0% / 20.0% (n=10)", "40.0% / 30.0% (n=10)"]
-    assert share[4].startswith("p = ")
+    # The comparison's measures: each trial's shares (one trial a group here).
+    small = trial_values.small_tool_uses(results).set_index("group")["value"]
+    assert small["physical"] == pytest.approx(3 / 5) and small["kinematic"] == pytest.approx(1 / 4)
+    shares = trial_values.study_tool_shares(results).set_index("group")
+    assert shares.loc["physical", ["study's rule", "at least 1 mm"]].tolist() == [0.5, 0.2]
+    assert measure_notes.small_tool_uses(results.select("physical"), TOOL_MIN_MOTION) == (
+        "3 of 5 tool uses"
+    )
 
 
-def test_pages_say_not_recorded_and_leave_out_batches_without_tests():
+def test_trials_without_the_stick_motion_are_not_recorded_and_not_tested():
     old = _results(PHYSICAL.drop(columns="stick_dx"))
     table = tool_motion_table(old)
     assert table is not None and table.rows[0][3] == "not recorded"
-    rows = comparison_rows(old, _results(KINEMATIC))
-    assert rows[0][1] == "not recorded" and rows[0][4] == "n/a" and rows[1][4] == "n/a"
-    none = _results(pd.DataFrame(columns=["group", "strategy", "stick_dx"]))
+    assert trial_values.small_tool_uses(old)["value"].isna().all()
+    evaluated = differences.evaluate(tuple(tool_rule_measures()), old, _results(KINEMATIC))
+    for e in evaluated:
+        assert e.outcomes == () and e.untested == (("", "physical: not recorded"),)
+        assert differences.side_text(e.measure, old, e.values[0]) == "not recorded"
+    none = _results(pd.DataFrame(columns=["group", "trial", "seed", "strategy", "stick_dx"]))
     assert tool_motion_table(none) is None
-    assert comparison_rows(none, _results(KINEMATIC)) == []
 
 
 def test_study_tests_keep_the_stick_motion_their_rule_compared(trained_trial):
