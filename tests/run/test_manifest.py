@@ -11,16 +11,15 @@ import warnings
 
 import pytest
 from old_trials import as_before_manifests
+from test_trial_integrity import _cli, _contents, _copy
 from trial_states import same_state
 
 from experiments import backend_record, manifest, storage
 from experiments.analysis.logs import read_log
 from experiments.batches.runner import is_complete, run_and_evaluate
-from experiments.cli.main import main
 from experiments.file_names import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
-    LOCK_FILE,
     LOG_DIR,
     MANIFEST_DIR,
     MEMORY_DIR,
@@ -46,21 +45,6 @@ def base(tmp_path_factory):
     run_trial(out, SETTINGS, progress=False)
     evaluate_trial(out, EvaluationSettings(n_placements=1))
     return out
-
-
-def _copy(base, tmp_path, name: str = "trial"):
-    out = tmp_path / name
-    shutil.copytree(base, out)
-    return out
-
-
-def _contents(out) -> dict:
-    return {p: p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != LOCK_FILE}
-
-
-def _cli(capsys, *argv: str) -> tuple[int, list[str]]:
-    code = main(list(argv))
-    return code, capsys.readouterr().err.strip().splitlines()
 
 
 def _xor_middle(path, count: int = 64) -> None:
