@@ -73,3 +73,23 @@ def _section(config: dict, key: str) -> tuple[dict | None, str]:
     for parent in parents:
         node = node.get(parent) if isinstance(node, dict) else None
     return (node if isinstance(node, dict) else None), last
+
+
+class UnknownSettingError(ValueError):
+    """A config.json naming a setting no version of the project wrote (one line names it)."""
+
+
+def check_known(config: dict, path: object) -> None:
+    """UnknownSettingError naming the first setting of a section declared here (SECTIONS: the
+    world and the voice) that no field declares: a config.json edited by hand, which every
+    reader names as such rather than as another trial's (its identity hash changes with it)."""
+    for section, cls in SECTIONS.items():
+        values = config.get(section)
+        if isinstance(values, dict):
+            known = {f.name for f in dataclasses.fields(cls)}
+            unknown = sorted(set(values) - known)
+            if unknown:
+                raise UnknownSettingError(
+                    f"{path} has an unknown setting {section}.{unknown[0]}, which no version of "
+                    "the project writes: remove it (an edit by hand?)"
+                )

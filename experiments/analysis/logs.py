@@ -25,7 +25,7 @@ import pandas as pd
 from experiments import manifest, storage
 from experiments.analysis.batch_checks import check_batch
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
-from experiments.config_file import with_added_settings
+from experiments.config_file import UnknownSettingError, check_known, with_added_settings
 from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import (
     LOST_CHUNK_REMEDY,
@@ -78,6 +78,11 @@ def _read_log(
         return pd.DataFrame(), recorded is not None
     config_path = trial_dir / CONFIG_FILE
     config = with_added_settings(storage.read_json(config_path)) if config_path.exists() else None
+    if config is not None:
+        try:
+            check_known(config, config_path)
+        except UnknownSettingError as exc:
+            raise storage.CorruptFileError(str(exc)) from None
     own = _identity_of(config)
     wanted = None if columns is None else [*SOURCE_COLUMNS, *columns]
     frames = []

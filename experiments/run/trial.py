@@ -25,7 +25,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments import backend_record, manifest, provenance, storage
-from experiments.config_file import with_added_settings
+from experiments.config_file import UnknownSettingError, check_known, with_added_settings
 from experiments.file_names import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
@@ -149,11 +149,14 @@ class Trial:
                     f"{d} already holds a trial; add --resume to continue it, or choose a new "
                     "directory"
                 )
+            held = with_added_settings(storage.read_json(config_path))
+            try:
+                check_known(held, config_path)
+            except UnknownSettingError as exc:
+                raise TrialError(str(exc)) from None
             diff = [
                 f"{key}: {a!r} != {b!r}"
-                for key, a, b in storage.config_differences(
-                    with_added_settings(storage.read_json(config_path)), self.config
-                )
+                for key, a, b in storage.config_differences(held, self.config)
                 if key not in EXTENSIBLE
             ]
             if diff:

@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 
 from experiments import manifest, storage
-from experiments.config_file import with_added_settings
+from experiments.config_file import UnknownSettingError, check_known, with_added_settings
 from experiments.file_names import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
@@ -85,6 +85,10 @@ def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dic
     if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
         raise TrialError(f"{trial_dir} has no checkpoint yet")
     config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+    try:
+        check_known(config, trial_dir / CONFIG_FILE)
+    except UnknownSettingError as exc:
+        raise TrialError(str(exc)) from None
     agent, room, meta, fallback = restore_newest(trial_dir, config)
     if fallback is not None:
         # Only the resume may fall back: it rewrites the logs past the previous checkpoint.

@@ -83,3 +83,23 @@ def test_d9_a_key_given_twice_is_refused_in_a_trials_config(trained_trial, tmp_p
     assert _files(trial) == before
     with pytest.raises(storage.CorruptFileError, match="appears twice"):
         storage.read_json(trial / CONFIG_FILE)
+
+
+def test_d10_an_unknown_setting_in_a_trials_config_is_named_as_such(
+    trained_trial, tmp_path, capsys
+):
+    from experiments.analysis.logs import read_log
+
+    trial = tmp_path / "trial"
+    shutil.copytree(trained_trial.dir, trial)
+    config = storage.read_json(trial / CONFIG_FILE)
+    config["world"]["foo"] = 1
+    storage.write_json(trial / CONFIG_FILE, config)
+    before = _files(trial)
+    for argv in (["eval", str(trial), "--quiet"], ["run", "--out", str(trial), "--resume"]):
+        code, err = _cli(capsys, *argv)
+        assert code == 2 and len(err) == 1, err
+        assert "unknown setting world.foo" in err[0] and "another" not in err[0]
+    with pytest.raises(storage.CorruptFileError, match="unknown setting world.foo"):
+        read_log(trial)  # not "belongs to another trial"
+    assert _files(trial) == before
