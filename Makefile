@@ -91,7 +91,7 @@ contact-ablations: comparison-diva
 	$(BIN)/playroom ablations $(OUT)/comparison-diva \
 		$(addprefix $(OUT)/contact-ablation-,$(CONTACT_ABLATIONS)) --out $(OUT)/contact-ablations
 
-## contact-ladder: issue 40's rungs from the study's kinematic rules to the physical backend, one
+## contact-ladder: the rungs from the study's kinematic rules to the physical backend, one
 ## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
 ## DIVA; rungs 0 and 5 are comparison-diva's halves); a rung that is a contact ablation (the
 ## same batch) runs into that ablation's directory. Then `playroom ablations` of every rung

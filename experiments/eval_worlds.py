@@ -1,4 +1,4 @@
-"""The worlds a trial's final agent can be tested in besides its own (issue 40).
+"""The worlds a trial's final agent can be tested in besides its own.
 
 A comparison of backends mixes what agents learned with the world they are tested in, as long
 as every agent is tested in the world it learned in. An eval world is a grasp backend and the
@@ -15,7 +15,7 @@ What an eval world changes, and what it keeps:
   the trial's overrides of it, then its own `settings` on top. So `kinematic` is the kinematic
   backend with the catch rule of the trial's preset (the study preset: the study's rule), and
   `physical` the physical backend with objects pushed and no settling, whatever ablation the
-  trial learned in. A rung of issue 40's ladder (a batch config that sets world switches) is
+  trial learned in. A rung of the contact ladder (a batch config that sets world switches) is
   one more entry of EVAL_WORLDS with those switches in its `settings`.
 
 A trial is never evaluated twice in one world: an eval world equal to the trial's own (same

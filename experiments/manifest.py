@@ -1,6 +1,6 @@
 """What a trial wrote, file by file: every data file's size and SHA-256, recorded with the
 checkpoint that covers it, so that a reader tells a damaged, missing or foreign file from a
-good one before it computes anything from it (issue 39).
+good one before it computes anything from it.
 
 What is recorded. Every data file of a trial directory but its checkpoints: the log chunks of
 both kinds (`log/iterations/chunk-*.parquet`, `log/words/chunk-*.parquet`), the memory

@@ -197,7 +197,7 @@ def _refuse_duplicates(pairs: list[tuple[str, Any]]) -> dict:
 def strict_json(text: str) -> Any:
     """JSON text parsed as `json.loads` does, but a key given twice in one object is a
     DuplicateKeyError (json.loads keeps the last one silently): every JSON file the project
-    reads is read so (issue 39)."""
+    reads is read so."""
     return json.loads(text, object_pairs_hook=_refuse_duplicates)
 
 

@@ -2,7 +2,7 @@
 
 Why: the screen (learner/quantized_scan.py) reads every row's codes, so a query's cost grew
 with the memory: 0.013 ms at a study-length trial's memories, 0.144 ms at 10^6 iterations
-(issue 34). The agent's memories are not spread like its queries: a model's outcomes lie near
+(docs/speed.md). The agent's memories are not spread like its queries: a model's outcomes lie near
 what the arm's few joints can do, or on a few sounds, its goals anywhere in [-1, 1]^10. Cut
 into leaves of rows close to one another, a memory lets a query pass over every leaf whose
 bounding box lies beyond the screen's limit (docs/speed.md, "The nearest-neighbour index").

@@ -102,7 +102,7 @@ def tuples(value: Any) -> Any:
 # The largest seed of a trial or batch: every log row records its seed in an int64 Parquet
 # column (experiments/analysis/logs.py), which holds no more. NumPy's generators take any
 # non-negative integer, and nothing derives a seed from a trial's (seed * K + i), so the
-# column is the only bound; seeds up to it ran, were evaluated and reported (issue 31).
+# column is the only bound; seeds up to it ran, were evaluated and reported.
 MAX_SEED = 2**63 - 1
 
 

@@ -1,6 +1,6 @@
 """The arm's position servos alone: the joint angles the physical model's servos reach while
 tracking joint targets, with the arm touching nothing (WorldConfig.arm_dynamics "servo", a rung
-of the contact ladder, issue 40: the kinematic rules acting on a simulated arm).
+of the contact ladder, docs/world.md: the kinematic rules acting on a simulated arm).
 
 The arm is the physical room's own (models/playroom.xml: its links, joints, armature, damping,
 limits and actuators, kp and damping ratio), compiled without the objects, the caregiver, the

@@ -106,7 +106,7 @@ class WorldConfig:
     # DIVA's formant map, the study's synthesizer, whose data the user installs (docs/protocol.md
     # D13). Trials written before the choice ran with VocalTractLab.
     voice: str = dataclasses.field(default=DEFAULT_TRACT, metadata={BEFORE: DEFAULT_TRACT})
-    # Ablation of pushing (issue 32, docs/comparison.md), never a default: False holds every
+    # Ablation of pushing (docs/comparison.md), never a default: False holds every
     # object that nothing holds where it lies (the physical backend multiplies its table
     # damping by UNPUSHED_DAMPING_FACTOR), so that, as in the kinematic rules, only a grasp, a
     # catch or the caregiver moves an object. The kinematic backend never pushes. Older trials
@@ -114,7 +114,7 @@ class WorldConfig:
     push_objects: bool = dataclasses.field(
         default=True, metadata={BEFORE: True, ACTS_ON: ("physical",)}
     )
-    # Ablation of after-effects (issue 32), never a default: True lets the physical room settle
+    # Ablation of after-effects, never a default: True lets the physical room settle
     # between movements (SETTLE_PHYSICS_STEPS with the arm at rest), so that objects left
     # overlapping by a release, the arm's return to rest or the caregiver's putting a toy down
     # part before the next context is read, not during the next movement. Older trials did not
@@ -122,7 +122,7 @@ class WorldConfig:
     settle_between_movements: bool = dataclasses.field(
         default=False, metadata={BEFORE: False, ACTS_ON: ("physical",)}
     )
-    # A rung of the contact ladder (issue 40), never a default: how the kinematic rules move
+    # A rung of the contact ladder, never a default: how the kinematic rules move
     # the arm. "set": its joints are set to the DMP targets (the study's rule); "servo": they
     # are where the physical model's position servos, tracking the same targets through the
     # dynamics with the arm touching nothing, take them (sim/arm_servo.py); the grasp, catch
@@ -130,7 +130,7 @@ class WorldConfig:
     arm_dynamics: str = dataclasses.field(
         default="set", metadata={BEFORE: "set", ACTS_ON: ("kinematic",)}
     )
-    # A rung of the contact ladder (issue 40), never a default: where the physical backend
+    # A rung of the contact ladder, never a default: where the physical backend
     # holds what it takes. "touch": welded at the pose of the touch (D16); "aligned": placed
     # and welded as the kinematic rules hold it, the stick's handle at the hand pointing along
     # the last segment, a toy at the hand or at the held stick's tip. Older trials: "touch".

@@ -10,7 +10,7 @@ from experiments import storage
 from experiments.file_names import CHECKPOINT_FILE, MANIFEST_DIR, PREVIOUS_CHECKPOINT_FILE
 from experiments.manifest import MANIFEST_KEY
 
-# What checkpoints recorded of their directory from issue 39 on.
+# What checkpoints recorded of their directory since manifests.
 _SINCE_MANIFESTS = (MANIFEST_KEY, "trial_name")
 
 

@@ -1,4 +1,4 @@
-"""Agents tested in the worlds they did not learn in (issue 40), read back as one table: for
+"""Agents tested in the worlds they did not learn in, read back as one table: for
 every trial of some batches and every test world, the trial's numbers as that world tested its
 final agent, so that a difference between two conditions splits into what the agents learned
 (the same test world, agents of both) and what the test world does (the same agents, both

@@ -1,4 +1,4 @@
-"""A batch's final agents as tested in one eval world, read into tables (issue 40).
+"""A batch's final agents as tested in one eval world, read into tables.
 
 `collect(batch_dir, world)` is `experiments.analysis.results.collect` reading each trial's
 evaluation in eval world `world` (experiments/eval_worlds.py) instead of its own: the same

@@ -1,4 +1,4 @@
-"""What a trial's logs say about why two conditions differ (issue 32): per-trial numbers of
+"""What a trial's logs say about why two conditions differ: per-trial numbers of
 where the agent's exploration went, what it heard and what the caregiver understood.
 
 From the iterations log (experiments/analysis/logs.py) and the trial's names:

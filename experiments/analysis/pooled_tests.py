@@ -1,5 +1,5 @@
 """Tests on counts or values pooled over the trials' tests, words or iterations: the tests the
-comparison page showed alone before issue 40, now only a labelled second line beside the
+comparison page showed alone before, now only a labelled second line beside the
 per-trial test (experiments/analysis/trial_tests.py). They treat every test (word, iteration)
 as independent, which the tests of one agent are not: their p is smaller than the batch
 supports, the more so the more tests each trial holds.

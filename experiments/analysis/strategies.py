@@ -1,4 +1,4 @@
-"""Strategy shares under two definitions of "tool", like with like across backends (issue 32).
+"""Strategy shares under two definitions of "tool", like with like across backends.
 
 The study counted an arm test as "tool" when the stick moved (docs/protocol.md §10, D23). In
 the kinematic backend a stick moves only when held; in the physical one it is also pushed, so

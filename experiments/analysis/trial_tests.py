@@ -1,4 +1,4 @@
-"""Tests of differences with the trial, not the test or the word, as the unit (issue 40).
+"""Tests of differences with the trial, not the test or the word, as the unit.
 
 The agents of a batch share their placements, and each is tested hundreds of times: tests
 (and words) of one trial are not independent of each other, so a test that counts them as

@@ -1,4 +1,4 @@
-"""One value per trial of everything a comparison tests (issue 40: the agent is the unit).
+"""One value per trial of everything a comparison tests (the agent is the unit).
 
 Each function takes a batch's tables (`BatchResults`, any number of groups) and returns one row
 per trial of `results.trials`: its trial, group and seed, then one column per part of the

@@ -1,4 +1,4 @@
-"""One step between two conditions (two rungs of issue 40's ladder, or a condition and its
+"""One step between two conditions (two rungs of the contact ladder, or a condition and its
 ablation), split into what the agents learned and what the test world does, with a test over
 trials paired by seed.
 

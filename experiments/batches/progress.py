@@ -10,7 +10,7 @@ Only a thread of the bar's own writes to the terminal. Reports arrive on the cli
 loop, which in a batch's own cluster also runs the scheduler: a bar drawn there, or a lock
 taken there that the batch's loop held while drawing, froze the scheduler whenever stderr
 blocked (a pipe not read for a while fills after about 140 trials of bar): workers idle,
-nothing started, the bar stuck on a trial long finished (issue 31). A stderr that blocks now
+nothing started, the bar stuck on a trial long finished. A stderr that blocks now
 holds up the bar alone.
 
 Reports and ends travel apart: a report reaches the client through the scheduler's event log, a

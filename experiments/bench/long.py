@@ -1,5 +1,5 @@
 """`playroom bench long`: the cost of development longer than the study's, measured on one
-trial of 10^6 iterations (issue 34): its cost per iteration and the bytes a checkpoint writes
+trial of 10^6 iterations: its cost per iteration and the bytes a checkpoint writes
 near 80000 iterations and near its end, from the memory segments it writes every 1000
 iterations (their write times and sizes), and its peak memory; then each model's inverse query
 on its final memories, scanned whole and through the nearest-neighbour index. One trial in a
@@ -34,11 +34,11 @@ LONG_ITERATIONS = 1_000_000
 NEAR = 80_000  # the study's length: the reference point
 WINDOW = 8_000  # iterations each cost is averaged over
 PERIOD = 1_000  # the trial's checkpoint period: one segment each
-# Issue 34's targets: cost and checkpoint bytes at 10^6 over 80000, peak memory.
+# The targets of long development: cost and checkpoint bytes at 10^6 over 80000, peak memory.
 COST_RATIO_TARGET = 2.0
 BYTES_RATIO_TARGET = 1.5
 PEAK_MEMORY_TARGET_MB = 4096
-# Issue 39's: checking every file of the trial against its manifest, under a second.
+# And checking every file of the trial against its manifest, under a second.
 MANIFEST_CHECK_TARGET_S = 1.0
 _NO_TREES = 2**62  # a memory that never sorts its rows into trees: the whole scan
 # The child prints its own peak resident memory after the trial (kB on Linux).

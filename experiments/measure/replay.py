@@ -1,5 +1,5 @@
 """Does a remembered movement repeat its outcome? A test of why a backend's competence within
-the hand's reach can fall to the random level (issue 32).
+the hand's reach can fall to the random level.
 
 The agent chooses a movement by its memory: the arm model's nearest experience to (context,
 goal) is a command m it made in a remembered context c, with a remembered outcome s. If m, redone

@@ -1,5 +1,5 @@
 """What the voice's toy models remember: the evidence behind the voice learning worse with
-contact grasping (issue 32).
+contact grasping.
 
 The agent's models 7-9 map a vocal command to a toy's trajectory; they store a movement only
 when its toy moved (the storing rule). Under the kinematic rules a toy moves during a vocal

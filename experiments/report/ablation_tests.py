@@ -1,5 +1,5 @@
 """The ablation table's measures (those of the registry marked `in_ablations`,
-experiments/report/measures.py), tested over trials (issue 40): each configuration's per-trial
+experiments/report/measures.py), tested over trials: each configuration's per-trial
 values against the baseline's on the same seeds (the paired t test of their differences), a gap
 measure's values also against 0 within the row, and Holm's correction over every test of the
 table (experiments/analysis/trial_tests.py).

@@ -185,7 +185,7 @@ def write_comparison(
         evaluated=evaluated,
         registry=registry(geometry),
     )
-    # Both definitions of "tool", with intervals over trials (issue 32: like with like).
+    # Both definitions of "tool", with intervals over trials (like with like).
     for group, numbers_of in strategy_definitions.summary_numbers(merged, geometry).items():
         content["by_group"][group]["strategy_definitions"] = numbers_of
     return write_page(Path(out_dir), figures, COMPARISON_FILE, page, summary_files(content))

@@ -1,6 +1,6 @@
 """The measures of the registry (experiments/report/measures.py) on two sides: per-trial
 values, the tests of their differences over trials, Holm's correction over every test the page
-makes, and the table and summary.json sections that show them (issue 40).
+makes, and the table and summary.json sections that show them.
 
 Each measure's parts are tested on one value per trial (experiments/analysis/trial_tests.py),
 paired over seeds where the sides hold the same seeds; a part a backend fixes by construction

@@ -1,4 +1,4 @@
-"""One registry of the measures the pages test (issue 40): each a `Measure` entry, read by the
+"""One registry of the measures the pages test: each a `Measure` entry, read by the
 comparison's table of differences (experiments/report/differences.py), the ablation table
 (experiments/report/ablations.py) and summary.json (experiments/report/summary.py). A new row
 of those is one entry here.

@@ -1,4 +1,4 @@
-"""The comparison's figures of why two sides differ (issue 32), beside the paper's figures:
+"""The comparison's figures of why two sides differ, beside the paper's figures:
 strategies with "tool" meaning the stick was held, what moved the goal toy in ring 1 after the
 agent's movement and after a random one, the gap between the error the agent expected and the
 error it got there, and the voice's social loop trial by trial."""

@@ -1,4 +1,4 @@
-"""What moved the goal toy in a ring's tests (issue 32), for the comparison's figure
+"""What moved the goal toy in a ring's tests, for the comparison's figure
 (experiments/report/mechanism_figures.py): what the chosen movement did to the goal toy against
 what a random command did to it in the very same scene (the project's measure plays both on one
 scene; experiments/measure/evaluation.py), and the error each outcome left: a competence at or

@@ -46,7 +46,7 @@ SECONDS_NEAR_GROWTH_FROM = 0.1327e-3
 SECONDS_NEAR_A_MILLION = 0.2331e-3
 # Bytes an iteration adds to the logs (docs/learning.md: about 120 KB per 1000 iterations) and to
 # the memory's segments (585 measured over iterations 1000 to 20000 of a kinematic trial, seed 0,
-# none during the study's bootstrap; 611 in issue 31's checkpoints, 416 MB at 681000: rounded up
+# none during the study's bootstrap; 611 in earlier checkpoints, 416 MB at 681000: rounded up
 # from the larger, as a disk that is too small fails a trial late).
 LOG_BYTES_PER_ITERATION = 120
 MEMORY_BYTES_PER_ITERATION = 620

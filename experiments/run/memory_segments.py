@@ -2,7 +2,7 @@
 
 A model's memory only grows, by about a row an iteration (learner/sensorimotor_model.py). A
 checkpoint holding every row rewrote them all each time: its bytes grew with the trial's
-length, and the bytes written over a trial with the square of it (issue 34: 416 MB
+length, and the bytes written over a trial with the square of it (416 MB
 checkpoints by iteration 681000, one every 1000 iterations). So the rows live apart, in
 append-only segments, and a checkpoint writes only those stored since the one before it:
 

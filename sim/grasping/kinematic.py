@@ -9,7 +9,7 @@ the held stick's tip) from that step on. tests/sim/test_kinematic_paths.py compa
 forms on thousands of commands, sample by sample and event by event: change a rule in both
 forms, and run it.
 
-Under `WorldConfig.arm_dynamics` "servo" (a rung of the contact ladder, issue 40) the arm is
+Under `WorldConfig.arm_dynamics` "servo" (a rung of the contact ladder) the arm is
 where the physical model's servos take it while tracking the targets (sim/arm_servo.py), not at
 the targets: both forms read its angles from the same servo steps, and the rules act on them.
 """

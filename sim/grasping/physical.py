@@ -4,7 +4,7 @@ when it touches it; the stick's tip catches a toy it touches. A grasp activates 
 holding the current relative pose. Unheld objects are pushed by whatever touches them. The
 caregiver carries a toy with her hand, a mocap body welded to it, lifted above the table.
 
-Under `WorldConfig.held_pose` "aligned" (a rung of the contact ladder, issue 40) what is taken
+Under `WorldConfig.held_pose` "aligned" (a rung of the contact ladder) what is taken
 is first placed where the kinematic rules hold it (sim/grasping/kinematic.py): the stick's
 handle at the hand, the stick along the last segment; a toy at the hand, or at the held stick's
 tip; the weld then holds that pose.
@@ -143,7 +143,7 @@ class PhysicalGrasp(GraspBackend):
         arm_to_rest(physics)
 
     def settle(self, physics: PlayroomPhysics) -> None:
-        """With `settle_between_movements` (an ablation, issue 32): the room's physics runs
+        """With `settle_between_movements` (an ablation): the room's physics runs
         SETTLE_PHYSICS_STEPS with the arm held at rest before the next movement, so that
         objects a release, the arm's return to rest or the caregiver's putting down left
         overlapping part now, and not during the next movement, where a vocal movement would
@@ -154,7 +154,7 @@ class PhysicalGrasp(GraspBackend):
         # those of the held, welded state before the release and the arm's return to rest.
         # Computed again for the room as it is now, as a movement's start computes them
         # (sim/playroom.py's placements end in mj_forward); without it the stale contact
-        # forces flung the stick up to 0.9 m in a settle (issue 32's first settle run).
+        # forces flung the stick up to 0.9 m in a settle (the first settle ablation run).
         mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
         physics.advance(SETTLE_PHYSICS_STEPS)
         physics.stop_objects()

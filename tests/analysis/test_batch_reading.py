@@ -1,4 +1,4 @@
-"""A batch is read only when every trial in it is whole and one of the batch (issue 39): a
+"""A batch is read only when every trial in it is whole and one of the batch: a
 missing chunk or evaluation table, or a trial copied twice or of another configuration, is
 refused in one line by `read_batch_logs` and `playroom report`, never pooled."""
 

@@ -1,5 +1,5 @@
 """A batch's final agents as tested in one eval world, read into the tables of its own
-evaluation (issue 40): each trial's own evaluation where that world is its own, its
+evaluation: each trial's own evaluation where that world is its own, its
 eval-in-WORLD/ otherwise, refused in one line when lacking, damaged or of another world."""
 
 from __future__ import annotations

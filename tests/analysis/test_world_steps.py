@@ -1,5 +1,5 @@
 """A step between two conditions split into what the agents learned and what the test world
-does, tested over agents paired by seed (issue 40)."""
+does, tested over agents paired by seed."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A batch directory holds one batch (issue 31): a rerun with other settings is refused in one
+"""A batch directory holds one batch: a rerun with other settings is refused in one
 line before anything is written or any cluster started, trials that disagree with the batch
 are named, reports refuse a directory whose trials disagree with its record, and a batch's
 logs read while it runs leave its unfinished trials out, saying which."""

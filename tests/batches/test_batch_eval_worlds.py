@@ -1,4 +1,4 @@
-"""A batch's `eval_worlds` (issue 40): every trial's final agent is also tested in each eval
+"""A batch's `eval_worlds`: every trial's final agent is also tested in each eval
 world; a rerun makes only the evaluations missing or damaged, never runs or evaluates a
 complete trial again, and may ask for more worlds."""
 

@@ -1,5 +1,5 @@
 """What `playroom batch` and the readers of a batch refuse before they write anything or compute
-a number (issue 39): a damaged batch record, a trial directory given as a batch's, a batch
+a number: a damaged batch record, a trial directory given as a batch's, a batch
 that cannot fit on its disk, a config naming a key twice."""
 
 from __future__ import annotations

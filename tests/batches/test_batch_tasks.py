@@ -1,4 +1,4 @@
-"""A batch's tasks on a cluster in this process (issue 31): a trial whose failure a retry would
+"""A batch's tasks on a cluster in this process: a trial whose failure a retry would
 repeat fails once, in the batch's one line, without Dask's traceback; and a stderr that nobody
 reads holds up the bar, never the scheduler, so the trials go on."""
 

@@ -1,4 +1,4 @@
-"""Issue 40's contact ladder (experiments/batches/contact-ladder/): from the comparison's
+"""The contact ladder (experiments/batches/contact-ladder/): from the comparison's
 kinematic trials (rung 0) to its physical ones (rung 5) and on to settling (rung 6), each rung
 changes one rule of the rung before, so that the rungs' steps add up to the whole difference.
 A rung is a batch config; rungs 0 and 5 are comparison-diva's own halves."""

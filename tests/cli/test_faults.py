@@ -336,7 +336,7 @@ def test_write_files_is_all_or_nothing(tmp_path, monkeypatch):
     assert _files(folder) == {"one": b"1", "two": b"2"}
 
 
-# Requests that ended in a traceback (issue 31): one line, exit code 2, nothing written ------
+# Requests that ended in a traceback: one line, exit code 2, nothing written ------
 TRACEBACKS = {
     # pyarrow could not write the seed into the log's int64 column.
     "seed beyond int64": (["--seed", "99999999999999999999999"], "seed must be"),

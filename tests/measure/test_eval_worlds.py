@@ -1,4 +1,4 @@
-"""A trial's final agent tested in another world than its own (issue 40): `playroom eval DIR
+"""A trial's final agent tested in another world than its own: `playroom eval DIR
 --world NAME` writes beside the trial, never into its files; an eval world equal to the trial's
 own is its own evaluation; an eval world changes only the backend and its switches, each
 switch read by the backend it is listed with."""
@@ -164,7 +164,7 @@ def test_an_eval_world_keeps_the_trials_world_but_the_backend_and_the_presets_sw
     held = _config(grasp="kinematic", overrides={"world": {"catch_rule": "held_stick"}})
     assert not own_world(held, "kinematic") and own_world(_config(grasp="kinematic"), "kinematic")
     # A switch the backend does not read leaves its world its own (no override can set one
-    # now, issue 39; a config.json may still hold one, written before that refusal).
+    # now; a config.json may still hold one, written before that refusal).
     unread = _config(grasp="physical")
     unread["world"]["catch_rule"] = "held_stick"
     assert own_world(unread, "physical")

@@ -1,6 +1,6 @@
 """`playroom eval` writes into a trial as its one writer: it takes the trial's lock before it
 reads anything (a live writer is named, never a checkpoint caught mid-rename), and it removes
-the temporary files that killed writers left there (issue 31, "Nothing mixed")."""
+the temporary files that killed writers left there."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The replay of remembered movements (experiments/measure/replay.py, issue 32): its test scene
+"""The replay of remembered movements (experiments/measure/replay.py): its test scene
 is the evaluation's own, and the remembered scenes are where the movement was learned."""
 
 from __future__ import annotations

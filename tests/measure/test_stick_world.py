@@ -1,5 +1,5 @@
 """The row "random arm commands that grasp the stick at its start" plays each backend in the
-world its trials ran in (issue 40): the DMP of the trials' preset turns the commands into
+world its trials ran in: the DMP of the trials' preset turns the commands into
 movements, and the project's DMP grasps another share of the same commands than the study's."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""What the voice's toy models remember (experiments/measure/voice_memory.py, issue 32): the
+"""What the voice's toy models remember (experiments/measure/voice_memory.py): the
 commands stored are told apart by what the caregiver hears in them."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""What the logs and the tests say of why two sides differ (issue 32): the numbers from a log,
+"""What the logs and the tests say of why two sides differ: the numbers from a log,
 the strategy shares under both definitions of "tool", and ring 1's outcomes, on tables whose
 answers are known by construction."""
 

@@ -1,4 +1,4 @@
-"""Pages a reader understands without the paper (issue 21, point 7): intervals that would
+"""Pages a reader understands without the paper: intervals that would
 mislead are flagged, the rings are named in metres. The pages themselves are checked in
 tests/report/test_report.py (page_checks.check_explained)."""
 

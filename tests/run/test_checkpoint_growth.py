@@ -1,4 +1,4 @@
-"""A checkpoint costs what changed since the one before it, not the trial's length (issue 34:
+"""A checkpoint costs what changed since the one before it, not the trial's length (when
 checkpoints that rewrote every row reached 416 MB by iteration 681000), and a trial whose
 checkpoints hold every row themselves (written before memory segments) is still read,
 evaluated, resumed and extended to the same trial."""

@@ -1,7 +1,7 @@
 """Every log chunk carries its trial's identity (the seed and the config's hash, as checkpoints
 do): a chunk of another trial copied into a trial is refused by a resume, an evaluation, a
 batch rerun and the readers, with one line naming the file and both identities; chunks written
-before chunks carried one are read and resumed as before (issue 31, "Nothing mixed")."""
+before chunks carried one are read and resumed as before."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Every reader checks what a trial wrote (issue 39): a data file damaged, missing, replaced or
+"""Every reader checks what a trial wrote: a data file damaged, missing, replaced or
 stray is refused in one line naming it by every reader (the Python API, eval, resume, batch,
 report), never read into a number; the manifest survives a kill at its own write; a trial
 keeps the name it was created as; a lost backend.json is regenerated when it can be."""

@@ -63,7 +63,7 @@ BAD_WORLD = [
         rf"stick_return_reach must be a finite number in {ROOM}, got '0.53'",
     ),
     ("stick_return_reach", INF, rf"stick_return_reach must be a finite number in {ROOM}, got inf"),
-    # No upper bounds before (issue 31): each of these ran to its end.
+    # No upper bounds before: each of these ran to its end.
     ("grasp_distance", 1e308, rf"grasp_distance must be a finite number in {ROOM}, got 1e\+308"),
     ("catch_distance", 4.0, rf"catch_distance must be a finite number in {ROOM}, got 4.0"),
     ("dmp_weight_scale", 1e308, r"dmp_weight_scale must be a finite number in \(0, 30000\]"),

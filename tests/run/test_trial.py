@@ -140,7 +140,7 @@ def test_directory_with_a_trial_is_refused_without_resume(tmp_path):
 def test_bad_arguments_exit_2_with_argparses_usage_or_one_line(tmp_path, capsys):
     a_file = tmp_path / "file"
     a_file.write_text("x")
-    # argparse's own errors: the command's usage line, then the error (issue 21).
+    # argparse's own errors: the command's usage line, then the error.
     parsing = [
         ["run", "--out", str(tmp_path / "a"), "--iterations", "0"],
         ["run", "--out", str(tmp_path / "a"), "--iterations", "-5"],

@@ -1,6 +1,6 @@
 """A long trial states its expected time and disk before it starts, and a trial that will not
 fit on its disk is refused, with one line, before anything is written, --quiet or not
-(issue 31: `--iterations 1000000000` started without a word; its checkpoints grew to 416 MB)."""
+(`--iterations 1000000000` started without a word; its checkpoints grew to 416 MB)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def test_disk_and_checkpoint_writes_grow_with_the_iterations_time_faster():
     two = estimate.trial_costs(TrialSettings(iterations=200000, checkpoint_every=1000))
     assert two.disk_bytes == pytest.approx(2 * one.disk_bytes, rel=0.01)
     # Each row of memory is written once (experiments/run/memory_segments.py), not by every
-    # checkpoint again (issue 34).
+    # checkpoint again.
     assert two.written_bytes == pytest.approx(2 * one.written_bytes, rel=0.01)
     assert two.seconds > 2 * one.seconds  # the query searches more rows as the memory grows
     slower = estimate.trial_costs(TrialSettings(grasp="physical", iterations=100000))
@@ -65,7 +65,7 @@ def test_the_issues_billion_iterations_are_refused_with_quiet(tmp_path, monkeypa
     assert main(run) == 2
     err = capsys.readouterr().err.strip().splitlines()
     # 740 GB: 740 B an iteration, the memory's rows written once (two checkpoints held them
-    # all before issue 34: 1.36 TB).
+    # all before: 1.36 TB).
     assert len(err) == 1 and "needs ~740 GB" in err[0] and "100 GB free" in err[0], err
     assert not out.exists()
 

@@ -1,4 +1,4 @@
-"""The contact ladder's rung 2 (issue 40, WorldConfig.arm_dynamics "servo"): the kinematic rules
+"""The contact ladder's rung 2 (WorldConfig.arm_dynamics "servo"): the kinematic rules
 acting on the arm the physical model's servos move, touching nothing. The arm lags its targets
 as the physical backend's does, to the bit in a room whose objects it never touches; grasps and
 catches stay the rules' distances, and nothing moves an object but a grasp or a catch."""

@@ -1,7 +1,7 @@
 """The contract every registered grasp backend keeps, run for each name in
 sim/grasping/registry.py's `REGISTRY` (a backend added there is tested here without editing
 this file), and for one more that only this file registers: a copy of the kinematic backend
-with twice the grasp distance, the extension the registry is for (issue 33), whose trials must
+with twice the grasp distance, the extension the registry is for, whose trials must
 be reported at its own reach, not at the one its config.json's grasp distance suggests.
 
 Each backend is loaded by name and built into a room; it acts (an arm and a voice command, with

@@ -1,5 +1,5 @@
 """The contact ladder's rungs 3 and 4 differ by where the physical backend holds what it takes
-(issue 40, WorldConfig.held_pose): at the pose of the touch ("touch", D16), or placed as the
+(WorldConfig.held_pose): at the pose of the touch ("touch", D16), or placed as the
 kinematic rules hold it ("aligned": the stick's handle at the hand along the last segment, a
 toy at the hand or at the held stick's tip), the weld then keeping that pose."""
 

@@ -1,4 +1,4 @@
-"""The ablation of pushing (WorldConfig.push_objects, issue 32): with it off, the physical room
+"""The ablation of pushing (WorldConfig.push_objects): with it off, the physical room
 moves an object only by a grasp, a catch or the caregiver, as the kinematic rules do; grasps
 and catches go on."""
 
