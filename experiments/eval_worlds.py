@@ -34,7 +34,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
-from sim.config import ACTS_ON, WorldConfig, world_preset
+from sim.config import backend_switches, world_preset
 
 # The trial's own world: its own evaluation (eval.json in the trial directory).
 OWN = "own"
@@ -42,13 +42,7 @@ OWN = "own"
 # The world settings that only some grasp backends read, by backend: declared once, beside each
 # field (sim/config.py ACTS_ON). tests/measure/test_eval_worlds.py checks that a backend's
 # movements do not change with a switch it is not listed with.
-_SWITCHED = [f for f in dataclasses.fields(WorldConfig) if ACTS_ON in f.metadata]
-READ_BY: Mapping[str, tuple[str, ...]] = MappingProxyType(
-    {
-        grasp: tuple(f.name for f in _SWITCHED if grasp in f.metadata[ACTS_ON])
-        for grasp in sorted({g for f in _SWITCHED for g in f.metadata[ACTS_ON]})
-    }
-)
+READ_BY: Mapping[str, tuple[str, ...]] = MappingProxyType(backend_switches())
 SWITCHES: tuple[str, ...] = tuple(s for switches in READ_BY.values() for s in switches)
 
 

@@ -192,15 +192,21 @@ def _check_rings(name: str, rings: Any) -> None:
         )
 
 
+def backend_switches() -> dict[str, tuple[str, ...]]:
+    """Backend -> the world settings only some backends read that its rules read (each field's
+    ACTS_ON), for every backend a field names."""
+    switched = [f for f in dataclasses.fields(WorldConfig) if ACTS_ON in f.metadata]
+    backends = sorted({g for f in switched for g in f.metadata[ACTS_ON]})
+    return {g: tuple(f.name for f in switched if g in f.metadata[ACTS_ON]) for g in backends}
+
+
 def inert_settings(grasp: str, changed: dict[str, Any]) -> list[str]:
     """The names among `changed` (world settings a trial changes from its preset) that no rule
-    of the backend `grasp` reads (their field's ACTS_ON names other backends)."""
-    fields = {f.name: f for f in dataclasses.fields(WorldConfig)}
-    return [
-        name
-        for name in changed
-        if name in fields and grasp not in fields[name].metadata.get(ACTS_ON, (grasp,))
-    ]
+    of the backend `grasp` reads: switches of other backends (`backend_switches`)."""
+    switches = backend_switches()
+    own = set(switches.get(grasp, ()))
+    others = {name for names in switches.values() for name in names} - own
+    return [name for name in changed if name in others]
 
 
 # The fields' defaults: the base every preset edits, equal to the "project" preset's world. A

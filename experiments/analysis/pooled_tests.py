@@ -10,7 +10,10 @@ not record what it pools.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+import pandas as pd
 from scipy import stats
 
 from experiments.analysis.results import BatchResults
@@ -98,32 +101,42 @@ def _stick_dx(side: BatchResults):
     return tests
 
 
-def small_tool_uses(
-    a: BatchResults, b: BatchResults, min_motion: float = TOOL_MIN_MOTION
+def _study_test_counts(
+    a: BatchResults, b: BatchResults, count: Callable[[pd.DataFrame], list[int]]
 ) -> list[PooledTest]:
-    """χ² of sides × (below, at least `min_motion`) on the pooled tool uses of study tests."""
+    """χ² of sides × the two counts `count` makes of each side's study tests (with stick_dx);
+    none where a side lacks them."""
     counts = []
     for side in (a, b):
         tests = _stick_dx(side)
         if tests is None:
             return []
-        dx = tests.loc[tests["strategy"] == "tool", "stick_dx"].abs()
-        counts.append([int((dx < min_motion).sum()), int((dx >= min_motion).sum())])
+        counts.append(count(tests))
     return _chi_square(np.array(counts), "tests")
+
+
+def small_tool_uses(
+    a: BatchResults, b: BatchResults, min_motion: float = TOOL_MIN_MOTION
+) -> list[PooledTest]:
+    """χ² of sides × (below, at least `min_motion`) on the pooled tool uses of study tests."""
+
+    def count(tests: pd.DataFrame) -> list[int]:
+        dx = tests.loc[tests["strategy"] == "tool", "stick_dx"].abs()
+        return [int((dx < min_motion).sum()), int((dx >= min_motion).sum())]
+
+    return _study_test_counts(a, b, count)
 
 
 def tool_share_min_motion(
     a: BatchResults, b: BatchResults, min_motion: float = TOOL_MIN_MOTION
 ) -> list[PooledTest]:
     """χ² of sides × (tool with at least `min_motion`, other) on the pooled study tests."""
-    counts = []
-    for side in (a, b):
-        tests = _stick_dx(side)
-        if tests is None:
-            return []
+
+    def count(tests: pd.DataFrame) -> list[int]:
         kept = int(((tests["strategy"] == "tool") & (tests["stick_dx"].abs() >= min_motion)).sum())
-        counts.append([kept, len(tests) - kept])
-    return _chi_square(np.array(counts), "tests")
+        return [kept, len(tests) - kept]
+
+    return _study_test_counts(a, b, count)
 
 
 def diverged(a: BatchResults, b: BatchResults) -> list[PooledTest]:
