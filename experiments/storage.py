@@ -13,7 +13,7 @@ import math
 import os
 import re
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -254,15 +254,34 @@ def read_table(
     columns of a wide table decodes only them. From `data`, its bytes already read (and
     checked), when given."""
     try:
+        source = _arrow_source(path, data)
         if columns is None:
-            return pd.read_parquet(path if data is None else io.BytesIO(data))
+            return pd.read_parquet(source())
         import pyarrow.parquet as pq
 
-        held = set(pq.read_schema(path if data is None else io.BytesIO(data)).names)
+        held = set(pq.read_schema(source()).names)
         kept = [c for c in columns if c in held]
-        return pd.read_parquet(path if data is None else io.BytesIO(data), columns=kept)
+        return pd.read_parquet(source(), columns=kept)
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+
+
+def _arrow_source(path: Path, data: bytes | None) -> Callable[[], Any]:
+    """What opens the table for pyarrow, once per read: `path`, or a reader of `data` over a
+    copy that Arrow owns. Given Python's bytes, pyarrow's
+    reader keeps a reference to them that one of its pool threads may drop after the read
+    returns; when that falls during interpreter exit, dropping it needs the GIL, the thread
+    is ended inside a C++ destructor and the process aborts ("terminate called without an
+    active exception", apache/arrow#49942), after a command has already printed its result.
+    A buffer Arrow owns is freed without Python."""
+    if data is None:
+        return lambda: path
+    import pyarrow as pa
+
+    stream = pa.BufferOutputStream()
+    stream.write(data)
+    owned = stream.getvalue()
+    return lambda: pa.BufferReader(owned)
 
 
 def read_column(path: Path, name: str, data: bytes | None = None) -> list:
@@ -270,11 +289,10 @@ def read_column(path: Path, name: str, data: bytes | None = None) -> list:
     decoded (a check that the whole file is readable, at half the cost of `read_table`).
     CorruptFileError if the file cannot be read or lacks the column. From `data`, its bytes
     already read (and checked), when given."""
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
     try:
-        table = pq.read_table(path if data is None else pa.BufferReader(data))
+        table = pq.read_table(_arrow_source(path, data)())
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
     if name not in table.column_names:
