@@ -93,21 +93,26 @@ contact-ablations: comparison-diva
 
 ## contact-ladder: the rungs from the study's kinematic rules to the physical backend, one
 ## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
-## DIVA; rungs 0 and 5 are comparison-diva's halves); a rung that is a contact ablation (the
-## same batch) runs into that ablation's directory. Then `playroom ablations` of every rung
-## against comparison-diva: rows pair by backend, so the kinematic rungs (1, 2) against its
-## kinematic trials, the physical ones (3, 4, 6) against its physical trials. Resumes
+## DIVA, every agent tested in both worlds; rungs 0 and 5 are comparison-diva's halves); a
+## rung that is a contact ablation (the same batch) runs into that ablation's directory. Then
+## `playroom ladder`: each step paired by seed, the steps' sum against the whole difference,
+## the cross-evaluation's split, Holm over every test (ladder.md/.csv/.json/.png). Resumes
 CONTACT_LADDER := $(basename $(notdir $(wildcard experiments/batches/contact-ladder/*.json)))
 contact-ladder: comparison-diva
-	dirs=; for rung in $(CONTACT_LADDER); do \
+	for rung in $(CONTACT_LADDER); do \
 		name=$${rung#*-}; out=$(OUT)/contact-ladder-$$rung; \
 		if [ -f experiments/batches/contact-ablations/$$name.json ]; then \
 			out=$(OUT)/contact-ablation-$$name; fi; \
 		$(BIN)/playroom batch --config experiments/batches/contact-ladder/$$rung.json \
 			--out $$out || exit 1; \
-		dirs="$$dirs $$out"; \
-	done; \
-	$(BIN)/playroom ablations $(OUT)/comparison-diva $$dirs --out $(OUT)/contact-ladder
+	done
+	$(BIN)/playroom ladder kinematic=$(OUT)/comparison-diva:kinematic \
+		held-stick-catch=$(OUT)/contact-ladder-01-held-stick-catch \
+		servo-arm=$(OUT)/contact-ladder-02-servo-arm \
+		contact-aligned=$(OUT)/contact-ladder-03-contact-aligned \
+		no-push=$(OUT)/contact-ablation-no-push \
+		physical=$(OUT)/comparison-diva:physical \
+		--beside settle=$(OUT)/contact-ablation-settle --out $(OUT)/contact-ladder
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the

@@ -93,6 +93,17 @@ def names_gap(results: BatchResults) -> pd.DataFrame:
     return keys.assign(**{VALUE: gap})
 
 
+def catches_per_grasp(results: BatchResults) -> pd.DataFrame:
+    """Each trial's toys caught with the stick per stick grasp (its two rates per 1000 arm
+    movements divided); NaN for a trial that never grasped the stick."""
+    trials = results.trials
+    columns = ("toy_catches_per_1000_arm", "stick_grasps_per_1000_arm")
+    if any(c not in trials.columns for c in columns):
+        return _empty(results)
+    catches, grasps = (trials.set_index("trial")[c].astype(float) for c in columns)
+    return per_trial(results, catches / grasps.where(grasps > 0))
+
+
 def only_pushed(results: BatchResults) -> pd.DataFrame:
     """Each trial's share of its tool tests (the project's tests, the study's rule: the stick
     moved) in which the hand never held the stick: it was only pushed."""

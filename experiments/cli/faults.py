@@ -136,6 +136,7 @@ KEPT: dict[str, Callable[[argparse.Namespace, list[str], str], str]] = {
     "report": _nothing_written,
     "compare": _nothing_written,
     "ablations": _nothing_written,
+    "ladder": _nothing_written,
 }
 
 

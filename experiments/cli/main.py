@@ -11,6 +11,7 @@ import textwrap
 
 from experiments.batches.stored import stored_profiles
 from experiments.bench.names import ON_REQUEST, SECTION_HELP, SECTION_NAMES
+from experiments.cli import ladder_command
 from experiments.cli.args import (
     Parser,
     VersionAction,
@@ -222,6 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="where to write ablations.md/.csv/.png")
     _study_reference_option(p)
     p.set_defaults(func=cmd_ablations)
+
+    ladder_command.add_parser(sub)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")

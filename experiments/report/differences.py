@@ -142,7 +142,7 @@ def value_text(kind: str, x: float) -> str:
         return pct(x, 1)
     if kind == "seconds":
         return "n/a" if not np.isfinite(x) else f"{1000 * x:.2f} ms / iteration"
-    return num(x, {"distance": 3, "iteration": 0}.get(kind, 1))
+    return num(x, {"distance": 3, "ratio": 2, "iteration": 0}.get(kind, 1))
 
 
 def side_text(measure: Measure, side: BatchResults, values: pd.DataFrame) -> str:

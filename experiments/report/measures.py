@@ -33,7 +33,7 @@ from experiments.report import measure_notes as notes
 
 DIFFERENCE, GAP, NONE = "difference", "gap", "none"
 # How a kind's values read on the pages (experiments/report/differences.py formats them).
-KINDS = ("share", "rate", "count", "distance", "iteration", "seconds")
+KINDS = ("share", "rate", "ratio", "count", "distance", "iteration", "seconds")
 
 
 @dataclass(frozen=True)
@@ -221,6 +221,15 @@ def _stick() -> list[Measure]:
         )
         for column, label, kind, fixed in STICK
     ]
+    out.append(
+        Measure(
+            "toy_catches_per_stick_grasp",
+            "Toys caught with the stick per stick grasp (each trial's two rates divided)",
+            "ratio",
+            trial_values.catches_per_grasp,
+            missing="no stick grasp (or not recorded)",
+        )
+    )
     out.append(
         Measure(
             "tool_tests_only_pushed",
