@@ -23,6 +23,8 @@ from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import DISTANCE_ONE
 from experiments.analysis.study_maps import BOOTSTRAP_SAMPLES
 from experiments.analysis.study_summary import FULL_COVERAGE, RANDOM_COMMANDS_PER_RING
+from experiments.analysis.trial_tests import one_sample_test
+from experiments.analysis.trial_values import VALUE, names_gap
 from experiments.report.pages import Table, ci_text, num, p_value, pct, shares_text
 
 PAPER_FILE = "paper.json"
@@ -159,7 +161,20 @@ def paper_rows(results: BatchResults, numbers: dict, geometry: Geometry) -> list
             paper["mann_whitney_p"].cell,
             *[f"U = {num(vocal[x]['u'], 1)}, {p_value(vocal[x]['p'])}" for x in g],
         ],
+        [
+            "Names vs distractors over trials, the agent the unit: each trial's median best "
+            "distance of its distractors minus its names, mean over trials, one-sample t "
+            "against 0 (two-sided)",
+            "(the study tested pooled words only)",
+            *[_names_gap_text(results.select(x)) for x in g],
+        ],
     ]
+
+
+def _names_gap_text(results: BatchResults) -> str:
+    """A group's names gap over trials: mean, t p and the trials behind it."""
+    test = one_sample_test(names_gap(results).set_index("trial")[VALUE])
+    return f"{num(test.difference, 3)}, {p_value(test.p)} (n={test.n[0]} trials)"
 
 
 def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:

@@ -297,6 +297,15 @@ def test_report_shows_the_papers_number_beside_ours(batches, tmp_path, monkeypat
         "0.23 (from 500 runs)",
         f"{names.median():.2f}",
     ]
+    # Beside the study's test on pooled words, the same question over trials.
+    gaps = [
+        t.loc[~t["is_name"], "best_distance"].median()
+        - t.loc[t["is_name"], "best_distance"].median()
+        for _, t in results.vocal.groupby("trial")
+    ]
+    over_trials = _row(page, "Names vs distractors over trials")[2]
+    assert over_trials.startswith(f"{np.mean(gaps):.3f}, p = ")
+    assert over_trials.endswith(f"(n={len(gaps)} trials)")
     # The paper column is read from the data file, not written into the code.
     edited = dataclasses.replace(published["competence_all"], text="12% <b>edited</b>")
     monkeypatch.setattr(paper, "published", lambda: {**published, "competence_all": edited})
