@@ -16,7 +16,7 @@ import pytest
 
 REPO = Path(__file__).parent.parent
 # What a wheel is built from: the project's files, without the repository's other contents.
-SOURCES = ("pyproject.toml", "README.md", "models", "sim", "learner", "experiments")
+SOURCES = ("pyproject.toml", "README.md", "LICENSE", "models", "sim", "learner", "experiments")
 
 
 def _build_wheel(tmp_path: Path) -> Path:
@@ -45,6 +45,10 @@ def test_the_wheel_ships_the_model_and_data_and_no_dev_tools(tmp_path):
         names = set(archive.namelist())
         metadata = archive.read(next(n for n in names if n.endswith("METADATA"))).decode()
     assert "models/playroom.xml" in names
+    assert {f"{p}/py.typed" for p in ("models", "sim", "learner", "experiments")} <= names
+    (licence,) = [n for n in names if n.endswith(".dist-info/licenses/LICENSE")]
+    with zipfile.ZipFile(wheel) as archive:
+        assert archive.read(licence).startswith(b"                    GNU GENERAL PUBLIC")
     voice_data = ("articulators", "formant_map", "productions", "vowels")
     assert {f"sim/vocal/vtl/data/{n}.npz" for n in voice_data} <= names
     assert "experiments/batches/profiles/demo.json" in names
