@@ -27,6 +27,11 @@ lock:
 	{ echo "# Exact versions for make run / make test, written by make lock on $$(date -u +%Y-%m-%d)"; \
 	  echo "# with $$(.lock-venv/bin/python -c 'import platform; print(platform.python_implementation(), platform.python_version(), platform.machine())')."; \
 	  .lock-venv/bin/python -m pip freeze --all --exclude playroom; } > $(LOCK).new
+	.lock-venv/bin/python -m pip install --quiet --dry-run --ignore-installed \
+		--report .lock-venv/rl.json --constraint $(LOCK).new ".[rl]"
+	{ echo "# The rl extra's own (make test-slow): resolved by make lock against the versions above,"; \
+	  echo "# without installing them (pip install --dry-run --report)."; \
+	  .lock-venv/bin/python .ci/lock_extra.py .lock-venv/rl.json $(LOCK).new; } >> $(LOCK).new
 	mv $(LOCK).new $(LOCK)
 	rm -rf .lock-venv
 

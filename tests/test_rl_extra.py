@@ -7,6 +7,8 @@ import subprocess
 import tomllib
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -29,3 +31,49 @@ def test_only_make_test_slow_installs_it_and_requires_its_checks_to_run():
     slow = _dry_run("test-slow")
     assert '-e ".[rl]"' in slow
     assert "PLAYROOM_RL_REQUIRED=1" in slow  # tests/sim/envs/test_env_sb3.py fails, not skips
+
+
+def _lock_extra():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("lock_extra", ROOT / ".ci" / "lock_extra.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_make_lock_adds_the_extras_distributions_the_lock_lacks():
+    report = {
+        "install": [
+            {"metadata": {"name": "stable_baselines3", "version": "2.9.2"}},
+            {"metadata": {"name": "NumPy", "version": "2.4.6"}},
+            {"metadata": {"name": "playroom", "version": "0.1.0"}},
+            {"metadata": {"name": "torch", "version": "2.14.1"}},
+        ]
+    }
+    lock = ["# a comment", "numpy==2.4.6", "Stable-Baselines3==2.9.2"]
+    assert _lock_extra().added_pins(report, lock) == ["torch==2.14.1"]
+
+
+def test_the_rl_extra_is_pinned_like_everything_else():
+    pins = {
+        line.split("==")[0].lower()
+        for line in (ROOT / "constraints.txt").read_text().splitlines()
+        if "==" in line
+    }
+    assert {"stable-baselines3", "torch"} <= {p.replace("_", "-") for p in pins}
+
+
+@pytest.mark.slow  # pip resolves torch's and stable-baselines3's requirements: ~20 s
+def test_every_distribution_the_rl_extra_brings_is_pinned(tmp_path):
+    import json
+    import sys
+
+    report = tmp_path / "rl.json"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--quiet", "--dry-run", "--ignore-installed",
+         "--report", str(report), "--constraint", str(ROOT / "constraints.txt"), f"{ROOT}[rl]"],
+        check=True, capture_output=True,
+    )  # fmt: skip
+    lock = (ROOT / "constraints.txt").read_text().splitlines()
+    assert _lock_extra().added_pins(json.loads(report.read_text()), lock) == []
