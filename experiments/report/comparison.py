@@ -26,6 +26,7 @@ from experiments.report import (
     strategy_definitions,
     tool_rule,
 )
+from experiments.report.backend_rules import backend_rules, rules_text
 from experiments.report.batch_report import numbers_and_figures
 from experiments.report.figures import FigureFile
 from experiments.report.measures import registry
@@ -162,6 +163,7 @@ def write_comparison(
         dirs=[str(d) for d in dict.fromkeys((dir_a, dir_b))],
         settings=settings_table(merged),
         configs=merged.configs,
+        backend_rules=rules_text(merged.configs),
         tests=tests,
         tests_note=tests_note(evaluated),
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),
@@ -185,6 +187,7 @@ def write_comparison(
         evaluated=evaluated,
         registry=registry(geometry),
     )
+    content["backend_rules"] = backend_rules(merged.configs)
     # Both definitions of "tool", with intervals over trials (like with like).
     for group, numbers_of in strategy_definitions.summary_numbers(merged, geometry).items():
         content["by_group"][group]["strategy_definitions"] = numbers_of
