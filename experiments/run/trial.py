@@ -38,7 +38,7 @@ from experiments.file_names import (
 )
 from experiments.log_layout import CHUNK_IDENTITY_KEY, EXTENSIBLE, chunk_path, source_of
 from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
-from experiments.run import estimate, memory_segments, stop_requests
+from experiments.run import estimate, memory_segments, progress_bar, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_checks import drop_logs_past, is_litter, prepare_resume, remove_litter
@@ -275,14 +275,8 @@ class Trial:
             report(self.iteration)
         # `with`: the bar's line is ended however the run ends (Ctrl-C, disk full), before
         # the command's last line.
-        with tqdm(
-            total=total,
-            initial=self.iteration,
-            disable=not progress,
-            unit="it",
-            desc=f"{self.settings.grasp} seed {self.settings.seed}",
-            dynamic_ncols=True,
-        ) as bar:
+        desc = f"{self.settings.grasp} seed {self.settings.seed}"
+        with progress_bar.trial_bar(total, self.iteration, progress, desc) as bar:
             self._run_to(total, bar, report, every)
             bar.set_postfix(self.counts)
         if report is not None and self.iteration % every != 0:  # the end, if not yet told
@@ -301,7 +295,9 @@ class Trial:
         chunk_start = self.iteration
         while self.iteration < total:
             stop_requests.raise_if_requested()  # one dropped in a finalizer (see there)
+            started = progress_bar.clock()
             rows.append(self._iterate())
+            progress_bar.leave_out_stall(bar, progress_bar.clock() - started)
             self.iteration += 1
             if self.iteration % WORDS_LOG_PERIOD == 0:
                 word_rows.append(self._word_row())
