@@ -10,6 +10,7 @@ from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.measure.stick import batch_worlds, grasp_rates
 from experiments.measure.study_measure import study_numbers
+from experiments.measure.untrained import untrained_numbers
 
 
 def room_measures(
@@ -23,7 +24,10 @@ def room_measures(
     backend in the world its trials in `batch_dirs` ran in (`stick.batch_worlds`)."""
     return RoomMeasures(
         study_numbers=functools.partial(
-            study_numbers, commands_per_ring=study_reference_commands, workers=workers
+            study_numbers,
+            commands_per_ring=study_reference_commands,
+            workers=workers,
+            beside=untrained_numbers,
         ),
         grasp_rates=functools.partial(grasp_rates, worlds=batch_worlds(batch_dirs)),
     )

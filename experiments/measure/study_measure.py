@@ -40,6 +40,7 @@ import functools
 import hashlib
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -162,7 +163,7 @@ def reference_cache_dir() -> Path:
 
 
 @functools.cache
-def _code_digest() -> str:
+def code_digest() -> str:
     """A digest of what plays a reference (this module and the pool's, the room's code, model
     and voice data): a reference kept by another version of the project is not read back as
     this one's."""
@@ -178,7 +179,7 @@ def _code_digest() -> str:
     return digest.hexdigest()
 
 
-def _read_kept(path: Path) -> pd.DataFrame | None:
+def read_kept(path: Path) -> pd.DataFrame | None:
     from experiments import storage
 
     try:
@@ -187,7 +188,7 @@ def _read_kept(path: Path) -> pd.DataFrame | None:
         return None
 
 
-def _keep(path: Path, reference: pd.DataFrame) -> None:
+def keep(path: Path, reference: pd.DataFrame) -> None:
     """Keep a played reference, if the cache can take it: a report never fails for its cache
     (a full or read-only cache directory only means playing the reference again next time)."""
     from experiments import storage
@@ -206,6 +207,7 @@ def study_numbers(
     progress: bool | None = None,
     workers: int | None = None,
     chunk_commands: int = CHUNK_COMMANDS,
+    beside: Callable[..., dict] | None = None,
 ) -> dict[str, dict]:
     """`study_summary` of each group of a batch (`experiments.analysis.results.BatchResults`) whose
     trials hold the study's tests: their tests pooled over trials (the study averaged errors
@@ -215,7 +217,9 @@ def study_numbers(
     it is kept in `cache_dir` (default: `reference_cache_dir()`) as
     `study-reference-<digest>.parquet` and read back by later reports, comparisons and
     ablations of any batch of those settings. progress: a bar of the commands played (None:
-    only on a terminal)."""
+    only on a terminal). `beside`: what else to measure of each group against its reference
+    (config, trials, tests, reference, cache), kept as its numbers' `untrained`: the reports
+    give experiments/measure/untrained.py's `untrained_numbers` (for_reports.py)."""
     cache = Path(cache_dir) if cache_dir is not None else reference_cache_dir()
     tests_of, paths, references, to_play = {}, {}, {}, {}
     for group, config in results.configs.items():
@@ -230,13 +234,13 @@ def study_numbers(
                 "config": config,
                 "commands": commands_per_ring,
                 "chunk": chunk_commands,
-                "code": _code_digest(),
+                "code": code_digest(),
             },
             sort_keys=True,
         )
         digest = hashlib.sha256(key.encode()).hexdigest()[:16]
         paths[group] = cache / f"study-reference-{digest}.parquet"
-        kept = _read_kept(paths[group])
+        kept = read_kept(paths[group])
         if kept is None:
             to_play[group] = config
         else:
@@ -245,7 +249,7 @@ def study_numbers(
         settings = StudyMeasureSettings(random_commands_per_ring=commands_per_ring)
         played = random_reference(to_play, settings, workers, progress, chunk_commands)
         for group, reference in played.items():
-            _keep(paths[group], reference)
+            keep(paths[group], reference)
         references.update(played)
     numbers = {}
     for group, tests in tests_of.items():
@@ -253,4 +257,9 @@ def study_numbers(
             continue
         numbers[group] = study_summary(tests, references[group])
         numbers[group]["reference_commands_per_ring"] = commands_per_ring
+        if beside is not None:
+            trials = results.trials[results.trials["group"] == group]
+            numbers[group]["untrained"] = beside(
+                results.configs[group], trials, tests, references[group], cache
+            )
     return numbers

@@ -199,6 +199,16 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
     def competence(numbers: dict) -> str:
         return pct(numbers["competence"]["all"]) + interval(numbers, "competence_all")
 
+    def untrained(numbers: dict) -> str:
+        if "untrained" not in numbers:
+            return "not measured"
+        still = numbers["untrained"]
+        return (
+            f"{pct(still['competence']['all'])}; {still['same_as_untrained']} of "
+            f"{still['trials']} trials untrained in every test, "
+            f"{pct(still['tests_as_untrained'])} of their tests"
+        )
+
     def shares(region: str):
         def text(numbers: dict) -> str:
             share = numbers["strategy_share"].get(region, {})
@@ -228,6 +238,14 @@ def _study_rows(groups: list[str], study: dict, paper: dict) -> list[list[str]]:
             "the central 95% of its resamples)",
             paper["competence_all"].cell,
             *[of(x, competence) for x in groups],
+        ],
+        [
+            "… an agent that never learned, as the study computed it (no data in any model: "
+            "the arm at rest in every test, the same placements and random reference; a random "
+            "command now and then knocks the toy away, stillness does not), and the trials "
+            "that scored exactly so (untrained), and the share of tests that did",
+            NOT_PUBLISHED,
+            *[of(x, untrained) for x in groups],
         ],
         *[
             [f"… ring {r}, {label}", NOT_PUBLISHED]
