@@ -74,7 +74,7 @@ def test_with_mujoco_gl_unset_the_room_and_its_environments_work_and_rendering_s
     code = """
 import gymnasium, sim
 sim.Playroom(grasp="physical").act_arm([0.1] * 21)
-env = gymnasium.make("sim.envs:Playroom-v0", iterations=10, render_mode="rgb_array")
+env = gymnasium.make("sim.envs:Playroom-v1", max_episode_steps=10, render_mode="rgb_array")
 env.reset(seed=0)
 env.step(env.action_space.sample())
 print("stepped", flush=True)

@@ -4,8 +4,9 @@ iterations (one step = one arm or voice command, as the study's agent acts):
 - `PlayroomMovementEnv` (sim/envs/dm_env_movement.py): a dm_env environment, dict action and
   observation specs;
 - `PlayroomGymEnv` (sim/envs/gym_env.py): the same world as a Gymnasium environment with Box
-  spaces, registered as "Playroom-v0" when this package is imported, so that
-  `gymnasium.make("sim.envs:Playroom-v0", grasp="physical")` works without importing it first.
+  spaces, registered when this package is imported as "Playroom-v1" and its variants
+  (sim/envs/versions.py: "PlayroomPhysical-v1", "PlayroomDiva-v1"), so that
+  `gymnasium.make("sim.envs:Playroom-v1", grasp="physical")` works without importing it first.
 
 Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
 (sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
@@ -25,17 +26,21 @@ from sim import environment_kept
 with environment_kept():
     from gymnasium.envs.registration import register, registry
 
+from sim.envs.versions import DIVA_ID, ENTRY_POINT, GYM_ID, PHYSICAL_ID, STUDY_ITERATIONS, VARIANTS
+
 if TYPE_CHECKING:
     from sim.envs.dm_env_movement import PlayroomMovementEnv
     from sim.envs.gym_env import PlayroomGymEnv
 
-GYM_ID = "Playroom-v0"
+for _id, _kwargs in VARIANTS.items():
+    if _id not in registry:  # a second import (importlib.reload) registers nothing twice
+        # The episode is the study's run, which Gymnasium's TimeLimit ends (a truncation), so
+        # that `spec.max_episode_steps` says how long it is; `max_episode_steps=N` shortens it.
+        register(
+            id=_id, entry_point=ENTRY_POINT, max_episode_steps=STUDY_ITERATIONS, kwargs=_kwargs
+        )
 
-if GYM_ID not in registry:  # a second import (importlib.reload) registers nothing twice
-    # No max_episode_steps: the environment truncates itself after its `iterations`.
-    register(id=GYM_ID, entry_point="sim.envs.gym_env:PlayroomGymEnv")
-
-__all__ = ["GYM_ID", "PlayroomGymEnv", "PlayroomMovementEnv"]
+__all__ = ["DIVA_ID", "GYM_ID", "PHYSICAL_ID", "PlayroomGymEnv", "PlayroomMovementEnv"]
 
 
 def __getattr__(name: str) -> Any:

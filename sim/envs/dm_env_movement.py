@@ -60,8 +60,9 @@ class PlayroomMovementEnv(dm_env.Environment):
     """The playroom, one step per arm or voice command (see the module's docstring).
 
     grasp: 'kinematic' (the default) or 'physical'; preset ('study', the default, or 'project')
-    or config (a whole `WorldConfig`); voice: the voice's numbers; iterations: commands per
-    episode; seed: the first episode's room.
+    or config (a whole `WorldConfig`); voice: the vocal tract, 'vtl' or 'diva' (the config's,
+    VocalTractLab by default, when None); voice_config: the voice's numbers; iterations: commands
+    per episode (None: episodes never end); seed: the first episode's room.
     """
 
     def __init__(
@@ -69,11 +70,12 @@ class PlayroomMovementEnv(dm_env.Environment):
         grasp: str = DEFAULT_GRASP,
         preset: str | None = None,
         config: WorldConfig | None = None,
-        voice: VoiceConfig = DEFAULT_VOICE,
-        iterations: int = STUDY_ITERATIONS,
+        voice: str | None = None,
+        voice_config: VoiceConfig = DEFAULT_VOICE,
+        iterations: int | None = STUDY_ITERATIONS,
         seed: int = 0,
     ) -> None:
-        self.settings = room_settings(grasp, preset, config, voice, iterations)
+        self.settings = room_settings(grasp, preset, config, voice, voice_config, iterations)
         self._next_seed: int | None = checked_seed(seed)
         self._seeds = np.random.default_rng(self._next_seed)
         self.episode_seed = self._next_seed
@@ -108,7 +110,8 @@ class PlayroomMovementEnv(dm_env.Environment):
         motor_space, command = motor_command(action)
         self.last_feedback = self.room.act(motor_space, command)
         observation = observed(self.room, self.last_feedback, self.bounds)
-        if self.room.iteration >= self.settings.iterations:
+        end = self.settings.iterations
+        if end is not None and self.room.iteration >= end:
             self._needs_reset = True
             return dm_env.truncation(0.0, observation)
         return dm_env.transition(0.0, observation)

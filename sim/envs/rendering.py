@@ -1,5 +1,6 @@
 """Frames of the room for the Gymnasium environment's render modes: "rgb_array" with MuJoCo's
-offscreen renderer, "human" in MuJoCo's passive viewer.
+offscreen renderer, "human" in MuJoCo's passive viewer; what a frame after a step shows, the
+room at the movement's end (`MovementEnd`).
 
 The offscreen backend is chosen as for videos (experiments/video/gl.py, which sim cannot
 import): the one `MUJOCO_GL` names, EGL when it is unset. MuJoCo picks its own GL context class
@@ -12,14 +13,17 @@ own (MuJoCo loads what `MUJOCO_GL` names at its import, nothing under `disable`)
 
 from __future__ import annotations
 
+import atexit
 import importlib
 import os
 import threading
+import weakref
 from typing import Any
 
 import mujoco
 import numpy as np
 
+from models.layout import N_STEPS
 from sim import GL_VARIABLE, environment_kept, gl_library_problem
 
 BACKENDS = ("egl", "osmesa", "glfw")
@@ -90,8 +94,9 @@ def checked_view(model: Any, size: tuple[int, int], camera: str) -> tuple[int, i
 
 class OffscreenRenderer:
     """RGB frames (height, width, 3) uint8 of a model's state from one of its cameras, in a GL
-    context of its own (what mujoco.Renderer does, with the context chosen here). Close it: an
-    EGL context left to the garbage collector at exit prints errors."""
+    context of its own (what mujoco.Renderer does, with the context chosen here). One not closed
+    is closed when collected or at exit, before MuJoCo's EGL display is terminated: an EGL
+    context freed after that (by the garbage collector at exit) prints an EGLError traceback."""
 
     def __init__(
         self, model: Any, size: tuple[int, int] = DEFAULT_SIZE, camera: str = "top"
@@ -109,6 +114,14 @@ class OffscreenRenderer:
                 f"({type(exc).__name__}: {exc}); set {GL_VARIABLE} to one of {', '.join(BACKENDS)}"
             ) from None
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
+        # The GL objects are freed by a finalizer that holds them, not the renderer, so that it
+        # runs when the renderer is collected. At exit it must run before mujoco.egl's atexit
+        # hook terminates the display: atexit runs hooks last registered first, and this one is
+        # registered after the context (hence after that hook), whereas weakref.finalize's own
+        # exit hook may have been registered before it, by any library's first finalizer.
+        self._free = weakref.finalize(self, _free_gl, self._context, self._mjr)
+        self._free.atexit = False
+        atexit.register(self._free)
         self._scene = mujoco.MjvScene(model, maxgeom=1000)
         self._option = mujoco.MjvOption()
         self._camera = mujoco.MjvCamera()
@@ -134,11 +147,42 @@ class OffscreenRenderer:
         return np.flipud(frame).copy()  # OpenGL's rows run bottom-up
 
     def close(self) -> None:
+        """Frees the GL context now (a second close does nothing)."""
         if self._mjr is not None:
-            self._context.make_current()
-            self._mjr.free()
+            self._free()
+            atexit.unregister(self._free)
             self._mjr = None
-            self._context.free()
+
+
+def _free_gl(context: Any, mjr: Any) -> None:
+    """Frees a renderer's MuJoCo GL objects, then its context."""
+    context.make_current()
+    mjr.free()
+    context.free()
+
+
+class MovementEnd:
+    """Watches a room's movements from now on and keeps its pose (joint positions and mocap
+    bodies) at each one's last control step: after it the room puts the arm back to rest, drops
+    what is held and places things for the next command, so the room as it is after a step no
+    longer shows the movement. Watching makes the room step its movements one control step at a
+    time (a `Playroom` step observer: the path videos take, held to the unwatched paths bit for
+    bit by tests/sim/test_kinematic_paths.py and tests/sim/test_compiled_steps.py): the same
+    world, more slowly."""
+
+    def __init__(self, room: Any) -> None:
+        self.room = room
+        self.pose: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        room.step_observers.append(self._observe)
+
+    def forget(self) -> None:
+        """No pose kept: until the next movement ends, frames show the room as it is."""
+        self.pose = None
+
+    def _observe(self, step: int, observation: dict) -> None:
+        if step == N_STEPS:
+            data = self.room.physics.data.ptr
+            self.pose = (data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
 
 
 def display_missing() -> str | None:

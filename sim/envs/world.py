@@ -9,22 +9,22 @@ toys placed and its caregiver moved between iterations by the room itself
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from models.layout import CONTEXT_DIM, SENSORY_DIM, block_slice
 from models.presets import DEFAULT_PRESET
+from models.tracts import TRACTS
 from models.world import Feedback
 from sim import events as ev
 from sim.config import WorldConfig, world_preset
+from sim.envs.versions import STUDY_ITERATIONS
 from sim.grasping.names import DEFAULT_GRASP
 from sim.playroom import Playroom
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 
-# One episode is one of the study's runs (docs/protocol.md §1, "Run length"); the same number as
-# `playroom run --iterations`'s default, which sim cannot import.
-STUDY_ITERATIONS = 80000
 # The sound block's bound (normalised log2 Hz, docs/protocol.md §4): four octaves either side of
 # the reference formants (F1 from 22 Hz to 5.8 kHz, F2 from 76 Hz to 19 kHz), beyond any voice;
 # random commands stay within +-1.6 in both tracts.
@@ -37,37 +37,67 @@ SEED_BOUND = 2**31
 
 @dataclass(frozen=True)
 class RoomSettings:
-    """The world every episode of an environment is built with; `iterations` per episode."""
+    """The world every episode of an environment is built with; `iterations` per episode (None:
+    no end of its own)."""
 
     grasp: str
     config: WorldConfig
-    voice: VoiceConfig
-    iterations: int
+    voice_config: VoiceConfig
+    iterations: int | None
 
     def room(self, seed: int) -> Playroom:
-        return Playroom(self.grasp, seed=seed, config=self.config, voice=self.voice)
+        return Playroom(self.grasp, seed=seed, config=self.config, voice=self.voice_config)
 
 
 def room_settings(
     grasp: str = DEFAULT_GRASP,
     preset: str | None = None,
     config: WorldConfig | None = None,
-    voice: VoiceConfig = DEFAULT_VOICE,
-    iterations: int = STUDY_ITERATIONS,
+    voice: str | None = None,
+    voice_config: VoiceConfig = DEFAULT_VOICE,
+    iterations: int | None = STUDY_ITERATIONS,
 ) -> RoomSettings:
     """The settings checked (one-line ValueError): `config` is the world's numbers, or else
-    those of `preset` (the default preset's when neither is given); not both."""
+    those of `preset` (the default preset's when neither is given), not both; `voice` names the
+    vocal tract as `playroom --voice` does (None: the config's), `voice_config` its numbers."""
     if preset is not None and config is not None:
         raise ValueError("give a preset or a config, not both (a config is a whole world)")
+    voice = checked_voice(voice)
+    voice_config = _checked_voice_config(voice_config)
     if config is None:
         config = world_preset(DEFAULT_PRESET if preset is None else preset)
-    if isinstance(iterations, bool) or not isinstance(iterations, int | np.integer):
-        raise ValueError(f"iterations must be a positive integer, got {iterations!r}")
-    if iterations < 1:
-        raise ValueError(f"iterations must be a positive integer, got {iterations}")
-    settings = RoomSettings(grasp, config, voice, int(iterations))
+    if voice is not None:
+        # The tract is a field of the world's config (sim/config.py): the name replaces it.
+        config = dataclasses.replace(config, voice=voice)
+    if iterations is not None:
+        if isinstance(iterations, bool) or not isinstance(iterations, int | np.integer):
+            raise ValueError(f"iterations must be a positive integer, got {iterations!r}")
+        if iterations < 1:
+            raise ValueError(f"iterations must be a positive integer, got {iterations}")
+        iterations = int(iterations)
+    settings = RoomSettings(grasp, config, voice_config, iterations)
     settings.room(0)  # ValueError naming the backends, or a config the MJCF disagrees with
     return settings
+
+
+def checked_voice(voice: object) -> str | None:
+    """A vocal tract's name as the command line's `--voice` takes it, or None; ValueError in one
+    line (a VoiceConfig given for it included: that is `voice_config`)."""
+    if voice is not None and not isinstance(voice, str):
+        kind = type(voice).__name__
+        raise ValueError(
+            f"voice is the vocal tract's name, one of {', '.join(TRACTS)}, got a {kind} (the "
+            "voice's numbers, a VoiceConfig, are voice_config)"
+        )
+    if voice is not None and voice not in TRACTS:
+        raise ValueError(f"unknown voice {voice!r}: one of {', '.join(TRACTS)}")
+    return voice
+
+
+def _checked_voice_config(value: object) -> VoiceConfig:
+    if not isinstance(value, VoiceConfig):
+        raise ValueError(f"voice_config must be a VoiceConfig, got a {type(value).__name__}")
+    return value
 
 
 def checked_seed(seed: object) -> int:

@@ -24,7 +24,7 @@ TOYS = np.array([[0.45, -0.3], [-0.6, 0.25], [0.15, 0.7]])
 
 
 def test_rgb_array_frames_show_the_room_where_it_is():
-    env = gymnasium.make(GYM_ID, render_mode="rgb_array", render_size=SIZE, iterations=10)
+    env = gymnasium.make(GYM_ID, render_mode="rgb_array", render_size=SIZE)
     env.reset(seed=0)
     room = env.unwrapped.movement_env.room
     room.arrange(toys=TOYS)
@@ -49,6 +49,8 @@ def _episode(render_mode: str | None) -> tuple[list[np.ndarray], list[np.ndarray
     env = PlayroomGymEnv(grasp="physical", iterations=10, render_mode=render_mode)
     env.action_space.seed(3)
     observations, frames = [env.reset(seed=2)[0]], []
+    if render_mode is not None:  # from here on the episode's movements are watched
+        frames.append(env.render())
     for _ in range(4):
         observations.append(env.step(env.action_space.sample())[0])
         if render_mode is not None:
@@ -59,6 +61,7 @@ def _episode(render_mode: str | None) -> tuple[list[np.ndarray], list[np.ndarray
 
 def test_rendering_follows_the_room_and_changes_nothing_of_it():
     plain, _ = _episode(None)
+    # Watched movements are stepped one control step at a time: the same world, bit for bit.
     rendered, frames = _episode("rgb_array")
     np.testing.assert_array_equal(np.array(rendered), np.array(plain))
     # Each movement moves the arm (or says something and the arm rests): frames differ.
@@ -102,11 +105,11 @@ GL_MODULES = ("OpenGL", "glfw", "mujoco.egl", "mujoco.osmesa", "mujoco.glfw")
 def test_without_a_render_mode_no_gl_is_loaded_and_a_disabled_gl_cannot_render():
     code = f"""
 import sys, gymnasium
-env = gymnasium.make("sim.envs:{GYM_ID}", iterations=10)
+env = gymnasium.make("sim.envs:{GYM_ID}")
 env.reset(seed=0)
 env.step(env.action_space.sample())
 print(sorted(m for m in {GL_MODULES!r} if m in sys.modules))
-env = gymnasium.make("sim.envs:{GYM_ID}", iterations=10, render_mode="rgb_array")
+env = gymnasium.make("sim.envs:{GYM_ID}", render_mode="rgb_array")
 env.reset(seed=0)
 env.render()
 """
@@ -124,11 +127,11 @@ HUMAN = f"""
 import sys, time, warnings
 import gymnasium
 from gymnasium.utils.env_checker import check_env
-env = gymnasium.make("sim.envs:{GYM_ID}", iterations=10)
+env = gymnasium.make("sim.envs:{GYM_ID}")
 with warnings.catch_warnings():
     warnings.simplefilter("error")
     check_env(env.unwrapped)  # every declared render mode, "human" included
-env = gymnasium.make("sim.envs:{GYM_ID}", iterations=10, render_mode="human")
+env = gymnasium.make("sim.envs:{GYM_ID}", render_mode="human")
 env.reset(seed=0)
 for _ in range(6):
     env.step(env.action_space.sample())

@@ -37,12 +37,12 @@ pytestmark = pytest.mark.slow
 def test_stable_baselines_checker_passes():
     import gymnasium
 
-    env = gymnasium.make(ENV_ID, iterations=10)
+    env = gymnasium.make(ENV_ID, max_episode_steps=10)
     check_env(env.unwrapped)  # raises on what SB3 cannot use; its advice only warns
 
 
 def test_make_vec_env_builds_from_the_id_and_renders_frames():
-    vec = make_vec_env(ENV_ID, n_envs=2, seed=0, env_kwargs={"iterations": 10})
+    vec = make_vec_env(ENV_ID, n_envs=2, seed=0)
     assert vec.render_mode == "rgb_array"  # SB3's default when it builds from an id
     observations = vec.reset()
     assert observations.shape == (2, 70)
