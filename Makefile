@@ -28,9 +28,11 @@ lock:
 	  echo "# with $$(.lock-venv/bin/python -c 'import platform; print(platform.python_implementation(), platform.python_version(), platform.machine())')."; \
 	  .lock-venv/bin/python -m pip freeze --all --exclude playroom; } > $(LOCK).new
 	.lock-venv/bin/python -m pip install --quiet --dry-run --ignore-installed \
-		--report .lock-venv/rl.json --constraint $(LOCK).new ".[rl]"
+		--extra-index-url $(TORCH_INDEX) --report .lock-venv/rl.json --constraint $(LOCK).new \
+		".[rl]"
 	{ echo "# The rl extra's own (make test-slow): resolved by make lock against the versions above,"; \
-	  echo "# without installing them (pip install --dry-run --report)."; \
+	  echo "# without installing them (pip install --dry-run --report); torch's CPU build, from"; \
+	  echo "# TORCH_INDEX (Makefile): the default one brings gigabytes of CUDA libraries."; \
 	  .lock-venv/bin/python .ci/lock_extra.py .lock-venv/rl.json $(LOCK).new; } >> $(LOCK).new
 	mv $(LOCK).new $(LOCK)
 	rm -rf .lock-venv
@@ -153,7 +155,13 @@ OTHER_CPU = $(shell $(BIN)/python -m experiments.bench.cpu_classes)
 # real reinforcement-learning library; `make test` never installs it.
 RL_INSTALLED := $(VENV)/.installed-rl
 
+# torch's CPU build, pinned in constraints.txt: PyPI's default build brings CUDA libraries
+# (5.2 GB on a CPU-only machine); for a GPU, install the torch you need into .venv yourself.
+TORCH_INDEX := https://download.pytorch.org/whl/cpu
+
+# torch alone from there first, so that only its few lookups go to that index.
 $(RL_INSTALLED): $(INSTALLED)
+	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --extra-index-url $(TORCH_INDEX) torch
 	$(BIN)/python -m pip install --quiet --constraint $(LOCK) -e ".[rl]"
 	touch $(RL_INSTALLED)
 

@@ -30,7 +30,18 @@ def test_only_make_test_slow_installs_it_and_requires_its_checks_to_run():
     assert '".[rl]"' not in _dry_run("test") and '".[rl]"' not in _dry_run("run")
     slow = _dry_run("test-slow")
     assert '-e ".[rl]"' in slow
+    # torch's CPU build: PyPI's default one brings gigabytes of CUDA libraries.
+    assert f"--extra-index-url {_torch_index()} torch" in slow
     assert "PLAYROOM_RL_REQUIRED=1" in slow  # tests/sim/envs/test_env_sb3.py fails, not skips
+
+
+def _torch_index() -> str:
+    (line,) = [
+        line
+        for line in (ROOT / "Makefile").read_text().splitlines()
+        if line.startswith("TORCH_INDEX :=")
+    ]
+    return line.split(":=", 1)[1].strip()
 
 
 def _lock_extra():
@@ -62,6 +73,10 @@ def test_the_rl_extra_is_pinned_like_everything_else():
         if "==" in line
     }
     assert {"stable-baselines3", "torch"} <= {p.replace("_", "-") for p in pins}
+    (torch,) = [line for line in (ROOT / "constraints.txt").read_text().splitlines()
+                if line.startswith("torch==")]  # fmt: skip
+    assert torch.endswith("+cpu")
+    assert not [p for p in pins if p.startswith(("nvidia", "cuda"))]
 
 
 @pytest.mark.slow  # pip resolves torch's and stable-baselines3's requirements: ~20 s
@@ -72,7 +87,8 @@ def test_every_distribution_the_rl_extra_brings_is_pinned(tmp_path):
     report = tmp_path / "rl.json"
     subprocess.run(
         [sys.executable, "-m", "pip", "install", "--quiet", "--dry-run", "--ignore-installed",
-         "--report", str(report), "--constraint", str(ROOT / "constraints.txt"), f"{ROOT}[rl]"],
+         "--report", str(report), "--constraint", str(ROOT / "constraints.txt"),
+         "--extra-index-url", _torch_index(), "--retries", "1", f"{ROOT}[rl]"],
         check=True, capture_output=True,
     )  # fmt: skip
     lock = (ROOT / "constraints.txt").read_text().splitlines()
