@@ -77,7 +77,8 @@ def parse_rung(text: str) -> Rung:
 def headline(geometry: Geometry) -> list[Headline]:
     """The ladder's measures: competence per ring, the tool share of the study's tests in each
     region under both definitions of a tool use, stick grasps, catches and catches per grasp,
-    words within the recognition distance and the names' gap."""
+    the study's tool uses that barely moved the stick (what its rule counts of a stick nudged
+    but not pushed away), words within the recognition distance and the names' gap."""
     by_name = {m.name: m for m in registry(geometry)}
     picked = [(name, VALUE, by_name[name].label) for name in COMPETENCE]
     for definition in DEFINITIONS:
@@ -88,6 +89,11 @@ def headline(geometry: Geometry) -> list[Headline]:
         ("stick_grasps_per_1000_arm", VALUE, by_name["stick_grasps_per_1000_arm"].label),
         ("toy_catches_per_1000_arm", VALUE, by_name["toy_catches_per_1000_arm"].label),
         ("toy_catches_per_stick_grasp", VALUE, "Toys caught with the stick per stick grasp"),
+        (
+            "study_tool_uses_below_min_motion",
+            VALUE,
+            by_name["study_tool_uses_below_min_motion"].label,
+        ),
         ("words_within", VALUE, by_name["words_within"].label),
         ("names_vs_distractors", VALUE, by_name["names_vs_distractors"].short),
     ]
@@ -159,7 +165,8 @@ def step_tests(
     ladder = values[values["seed"].isin(common_seeds(values, order))]
     pairs = [(STEP, a, b, ladder) for a, b in pairwise(order)]
     pairs.append((WHOLE, order[0], order[-1], ladder))
-    if len(ladder) < len(values[values["rung"].isin(order)]):
+    ends = [set(values.loc[values["rung"] == r, "seed"]) for r in (order[0], order[-1])]
+    if len(ends[0] & ends[1]) > len(common_seeds(values, order)):
         pairs.append((WHOLE_ALL, order[0], order[-1], values))
     pairs += [(BESIDE, order[-1], r, values) for r in beside]
     rows = []

@@ -163,3 +163,9 @@ def test_catches_per_grasp_is_each_trials_ratio_and_missing_without_a_grasp(batc
             assert ratio[trial] == pytest.approx(catches[trial] / grasps[trial])
         else:
             assert math.isnan(ratio[trial])
+
+
+def test_the_whole_on_every_seed_is_shown_only_where_the_ends_share_more_seeds():
+    values = _values(LEVELS, drop=("C", 3))  # the last rung lacks a seed: nothing more to say
+    steps = ladder.step_tests(values, ["A", "B", "C"], [], _headline())
+    assert "whole_all" not in set(steps["kind"])
