@@ -6,7 +6,10 @@ iterations (one step = one arm or voice command, as the study's agent acts):
 - `PlayroomGymEnv` (sim/envs/gym_env.py): the same world as a Gymnasium environment with Box
   spaces, registered when this package is imported as "Playroom-v1" and its variants
   (sim/envs/versions.py: "PlayroomPhysical-v1", "PlayroomDiva-v1"), so that
-  `gymnasium.make("sim.envs:Playroom-v1", grasp="physical")` works without importing it first.
+  `gymnasium.make("sim.envs:Playroom-v1", grasp="physical")` works without importing it first;
+- `PlayroomGoalEnv` (sim/envs/goal_env.py): the same world with one of the study's goals, in
+  Gymnasium-Robotics' goal-conditioned form (for hindsight relabelling), registered as
+  "PlayroomHandGoal-v0" and its siblings (sim/envs/versions.py, `GOAL_VARIANTS`).
 
 Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
 (sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
@@ -26,10 +29,21 @@ from sim import environment_kept
 with environment_kept():
     from gymnasium.envs.registration import register, registry
 
-from sim.envs.versions import DIVA_ID, ENTRY_POINT, GYM_ID, PHYSICAL_ID, STUDY_ITERATIONS, VARIANTS
+from sim.envs.versions import (
+    DIVA_ID,
+    ENTRY_POINT,
+    GOAL_ENTRY_POINT,
+    GOAL_EPISODE_STEPS,
+    GOAL_VARIANTS,
+    GYM_ID,
+    PHYSICAL_ID,
+    STUDY_ITERATIONS,
+    VARIANTS,
+)
 
 if TYPE_CHECKING:
     from sim.envs.dm_env_movement import PlayroomMovementEnv
+    from sim.envs.goal_env import PlayroomGoalEnv
     from sim.envs.gym_env import PlayroomGymEnv
 
 for _id, _kwargs in VARIANTS.items():
@@ -39,8 +53,25 @@ for _id, _kwargs in VARIANTS.items():
         register(
             id=_id, entry_point=ENTRY_POINT, max_episode_steps=STUDY_ITERATIONS, kwargs=_kwargs
         )
+for _id, _kwargs in GOAL_VARIANTS.items():
+    if _id not in registry:
+        # A goal episode is a few movements (GOAL_EPISODE_STEPS' comment), ended by TimeLimit.
+        register(
+            id=_id,
+            entry_point=GOAL_ENTRY_POINT,
+            max_episode_steps=GOAL_EPISODE_STEPS,
+            kwargs=_kwargs,
+        )
 
-__all__ = ["DIVA_ID", "GYM_ID", "PHYSICAL_ID", "PlayroomGymEnv", "PlayroomMovementEnv"]
+__all__ = [
+    "DIVA_ID",
+    "GOAL_VARIANTS",
+    "GYM_ID",
+    "PHYSICAL_ID",
+    "PlayroomGoalEnv",
+    "PlayroomGymEnv",
+    "PlayroomMovementEnv",
+]
 
 
 def __getattr__(name: str) -> Any:
@@ -48,6 +79,10 @@ def __getattr__(name: str) -> Any:
         from sim.envs import dm_env_movement
 
         return dm_env_movement.PlayroomMovementEnv
+    if name == "PlayroomGoalEnv":
+        from sim.envs import goal_env
+
+        return goal_env.PlayroomGoalEnv
     if name == "PlayroomGymEnv":
         from sim.envs import gym_env
 

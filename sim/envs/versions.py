@@ -29,3 +29,19 @@ VARIANTS: dict[str, dict[str, Any]] = {
     DIVA_ID: {"voice": "diva"},
 }
 ENTRY_POINT = "sim.envs.gym_env:make_registered"
+
+# The goal-conditioned ids (sim/envs/goal_env.py): the world of the ids above with one of the
+# study's goals. Their own versions: a new VERSION of the world makes a new one of these too.
+GOAL_VERSION = 0
+# Movements per goal episode: one reaches any goal drawn but a toy in the study's ring 3, which
+# needs the caregiver's help first (a name or two) and then the arm (PlayroomGoalEnv's docstring,
+# "Episode End"); short enough that the room never re-places the toys (every 20 iterations).
+GOAL_EPISODE_STEPS = 3
+# id -> its goal and grasp backend: each goal with the kinematic grasp, and "Physical" with the
+# physical one. The toy ids bring toy1 (`goal="toy2"` or "toy3" for another).
+GOAL_VARIANTS: dict[str, dict[str, Any]] = {
+    f"Playroom{name}Goal{suffix}-v{GOAL_VERSION}": {"goal": goal, **grasp}
+    for name, goal in (("Hand", "hand"), ("Stick", "stick"), ("Toy", "toy1"), ("Word", "word"))
+    for suffix, grasp in (("", {}), ("Physical", {"grasp": "physical"}))
+}
+GOAL_ENTRY_POINT = "sim.envs.goal_env:make_goal_registered"
