@@ -8,7 +8,6 @@ skipped where stable-baselines3 is not installed, with the reason."""
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import sys
@@ -16,21 +15,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rl_extra import require_stable_baselines3
 
 from sim.envs import GOAL_VARIANTS
 
-# Set by `make test-slow`, which installs the extra: there a missing library fails, never skips.
-REQUIRED = "PLAYROOM_RL_REQUIRED"
-
-try:
-    import stable_baselines3  # noqa: F401
-except ImportError:
-    if os.environ.get(REQUIRED):
-        raise
-    pytest.skip(
-        "stable-baselines3 is not installed: `make test-slow` installs it (the `rl` extra)",
-        allow_module_level=True,
-    )
+require_stable_baselines3()
 
 from stable_baselines3 import SAC, HerReplayBuffer  # noqa: E402
 

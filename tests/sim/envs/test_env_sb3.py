@@ -6,27 +6,16 @@ any other run they are skipped where stable-baselines3 is not installed, with th
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
+from rl_extra import require_stable_baselines3
 
 from sim.envs import GYM_ID
 
 ENV_ID = f"sim.envs:{GYM_ID}"
-# Set by `make test-slow`, which installs the extra: there a missing library fails, never skips.
-REQUIRED = "PLAYROOM_RL_REQUIRED"
+require_stable_baselines3()
 
-try:
-    import stable_baselines3
-except ImportError:
-    if os.environ.get(REQUIRED):
-        raise
-    pytest.skip(
-        "stable-baselines3 is not installed: `make test-slow` installs it (the `rl` extra)",
-        allow_module_level=True,
-    )
-
+import stable_baselines3  # noqa: E402
 from stable_baselines3 import PPO  # noqa: E402
 from stable_baselines3.common.env_checker import check_env  # noqa: E402
 from stable_baselines3.common.env_util import make_vec_env  # noqa: E402
