@@ -7,6 +7,7 @@ A rung beside the ladder floats, hatched, from the last rung. Shares in percent.
 from __future__ import annotations
 
 import math
+import textwrap
 
 import numpy as np
 import pandas as pd
@@ -15,6 +16,7 @@ from matplotlib.figure import Figure
 from experiments.report.ladder import BESIDE, OWN, STEP, Headline
 
 COLUMNS = 4
+TITLE_WIDTH = 50  # characters a panel's title line holds beside its neighbours' at this size
 UP, DOWN, LEVEL = "tab:green", "tab:red", "0.6"
 
 
@@ -49,7 +51,7 @@ def _panel(ax, h: Headline, steps: pd.DataFrame, levels: pd.DataFrame, order: li
         names.append(f"{step['to']} (beside)")
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xticks(range(len(names)), names, rotation=60, ha="right", fontsize=6)
-    ax.set_title(h.label, fontsize=7, wrap=True)
+    ax.set_title(textwrap.fill(h.label, TITLE_WIDTH), fontsize=7)
     ax.tick_params(axis="y", labelsize=6)
 
 
