@@ -34,7 +34,7 @@ from experiments.baseline.settings import (
     summary_config,
     trial_config,
 )
-from experiments.file_names import EVAL_FILE
+from experiments.file_names import BASELINE_FILE, EVAL_FILE, TRAINING_FILE
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
 from experiments.measure.trial_evaluation import evaluation_files, measured
@@ -42,9 +42,6 @@ from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.trial_files import fresh_trial_parts
 from sim.config import config_from_dict
 from sim.vocal.config import VoiceConfig
-
-BASELINE_FILE = "baseline.json"
-TRAINING_FILE = "training.json"
 
 
 def policy_file(toy: int) -> str:

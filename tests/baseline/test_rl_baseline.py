@@ -21,9 +21,13 @@ from rl_extra import require_stable_baselines3  # noqa: E402
 require_stable_baselines3()
 
 from experiments import manifest, storage  # noqa: E402
-from experiments.baseline.run import BASELINE_FILE, TRAINING_FILE, policy_file  # noqa: E402
+from experiments.baseline.run import policy_file  # noqa: E402
 from experiments.cli.main import main  # noqa: E402
-from experiments.file_names import EVALUATION_TABLES  # noqa: E402
+from experiments.file_names import (  # noqa: E402
+    BASELINE_FILE,
+    EVALUATION_TABLES,
+    TRAINING_FILE,
+)
 
 pytestmark = pytest.mark.slow
 
