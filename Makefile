@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations clean
+.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -164,6 +164,17 @@ $(RL_INSTALLED): $(INSTALLED)
 	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --extra-index-url $(TORCH_INDEX) torch
 	$(BIN)/python -m pip install --quiet --constraint $(LOCK) -e ".[rl]"
 	touch $(RL_INSTALLED)
+
+## rl-baseline: Model Babbling against deep RL on the same test, given the same movements: the
+## batch of experiments/batches/rl-baseline/comparison.json (both backends, 8 seeds x 20000
+## iterations), then for each of its trials SAC + HER (stable-baselines3's defaults) given as
+## many movements and tested the same way (`playroom rl-baseline --config`, on every core;
+## docs/rl-baseline.md); installs the `rl` extra; rerunning resumes
+RL_BASELINE := experiments/batches/rl-baseline/comparison.json
+rl-baseline: $(RL_INSTALLED)
+	$(BIN)/playroom batch --config $(RL_BASELINE) --out $(OUT)/rl-baseline/model-babbling
+	$(BIN)/playroom report $(OUT)/rl-baseline/model-babbling
+	$(BIN)/playroom rl-baseline --config $(RL_BASELINE) --out $(OUT)/rl-baseline/sac-her
 
 ## test-slow: the longer checks marked `slow` (with the `rl` extra installed: those checks fail
 ## rather than skip without it), then the whole suite with another CPU emulated

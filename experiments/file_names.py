@@ -76,6 +76,11 @@ TIMING_FILE = "timing.json"
 # moved aside with them when the trial is extended.
 EVAL_WORLD_PREFIX = "eval-in-"
 
+# A deep-RL baseline's run (experiments/baseline/run.py): its settings, then its policies' record
+# (each policy a policy-toyK.zip beside it); its evaluation is a trial's (the files above).
+BASELINE_FILE = "baseline.json"
+TRAINING_FILE = "training.json"
+
 # What a batch is: its spec as `playroom batch` last ran it (experiments/batches/spec.py).
 BATCH_FILE = "batch.json"
 

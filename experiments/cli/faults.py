@@ -125,6 +125,13 @@ def _eval_kept(args: argparse.Namespace, argv: list[str], then: str) -> str:
     return "the trial's evaluation files are as they were"
 
 
+def _baseline_kept(args: argparse.Namespace, argv: list[str], then: str) -> str:
+    return (
+        "each toy's policy trained in full is kept (a policy stopped midway starts again), and "
+        f"finished runs are kept; {then}rerun the same command to resume: {_command(argv)}"
+    )
+
+
 def _nothing_written(args: argparse.Namespace, argv: list[str], then: str) -> str:
     return "nothing was written"
 
@@ -137,6 +144,7 @@ KEPT: dict[str, Callable[[argparse.Namespace, list[str], str], str]] = {
     "compare": _nothing_written,
     "ablations": _nothing_written,
     "ladder": _nothing_written,
+    "rl-baseline": _baseline_kept,
 }
 
 

@@ -25,8 +25,9 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments.analysis.strategies import MOVERS
+from experiments.measure.actors import Actor, LearnerActor
 from learner.agent import Agent
-from models.layout import ARM_DIM, MOTOR_DIMS, MOVED_DISTANCE, block_slice
+from models.layout import MOTOR_DIMS, MOVED_DISTANCE, block_slice
 from sim import Playroom
 from sim import events as ev
 from sim.vocal.config import DEFAULT_VOICE
@@ -91,8 +92,17 @@ def strategy_of(motor_space: str, stick_moved: bool) -> str:
 def competence_table(
     agent: Agent, room: Playroom, settings: EvaluationSettings, progress: bool = False
 ) -> pd.DataFrame:
-    """One row per (ring, placement, toy): positions, the agent's strategy and error, the
-    random agent's error. The room is used as a test bench; the agent is only read."""
+    """`competence_of` the Model Babbling agent, asked as the project's measure asks it
+    (actors.LearnerActor). The agent is only read."""
+    return competence_of(LearnerActor(agent), room, settings, progress)
+
+
+def competence_of(
+    actor: Actor, room: Playroom, settings: EvaluationSettings, progress: bool = False
+) -> pd.DataFrame:
+    """One row per (ring, placement, toy): positions, the actor's strategy and error, the
+    random agent's error. The room is used as a test bench; the actor only chooses (actors.py):
+    the tests, the random reference and the errors are the same whoever acts."""
     rng = np.random.default_rng(settings.seed)
     stick_start = (*room.config.stick_start_handle, room.config.stick_start_angle)
     rows = []
@@ -109,17 +119,8 @@ def competence_table(
                 for toy in range(3):
                     goal = goal_trajectory(toys_of[p, toy])
                     block = block_slice(f"toy{toy + 1}")
-                    arm_model, voice_model = agent.toy_models(toy + 1)
-                    d_arm = agent.nearest_distance(arm_model, context, goal)
-                    d_voice = agent.nearest_distance(voice_model, context, goal)
-                    space, model = (
-                        ("arm", arm_model) if d_arm <= d_voice else ("voice", voice_model)
-                    )
-                    untrained = not np.isfinite(min(d_arm, d_voice))
-                    # A toy never moved has no model to invert: the arm stays at rest.
-                    command = (
-                        np.zeros(ARM_DIM) if untrained else agent.exploit(model, context, goal)
-                    )
+                    choice = actor.choose(toy + 1, context, goal)
+                    space, command = choice.motor_space, choice.command
                     feedback = room.act(space, command)
                     stick = feedback.s[block_slice("stick")]  # 5 x then 5 y
                     stick_moved = np.abs(stick - np.repeat(context[:2], 5)).max() > MOVED_DISTANCE
@@ -142,14 +143,14 @@ def competence_table(
                             "x": toys_of[p, toy, 0],
                             "y": toys_of[p, toy, 1],
                             "distance": float(np.linalg.norm(toys_of[p, toy])),
-                            "arm_nn_distance": d_arm,
-                            "voice_nn_distance": d_voice,
+                            "arm_nn_distance": choice.arm_nn_distance,
+                            "voice_nn_distance": choice.voice_nn_distance,
                             "strategy": strategy_of(space, bool(stick_moved)),
                             # A tool test either held the stick or only pushed it.
                             "stick_grasped": ev.STICK_GRASPED in feedback.kinds(),
                             "stick_contact": stick_contact,
                             "goal_moved_by": goal_moved_by,
-                            "untrained": untrained,
+                            "untrained": choice.untrained,
                             "error": error,
                             "random_error": random_error,
                             # what the random command in the same scene did to the goal toy

@@ -51,6 +51,7 @@ import models
 import sim
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING, study_summary
 from experiments.measure import reference_pool
+from experiments.measure.actors import Actor, Choice
 from experiments.measure.evaluation import goal_trajectory, movement_contacts, strategy_of
 from experiments.measure.reference_pool import CHUNK_COMMANDS, play_references, ring_placement
 from learner.agent import Agent
@@ -74,10 +75,37 @@ def _arm_context_of_the_study(context: np.ndarray, toy: str) -> np.ndarray:
     return swapped
 
 
+class StudyLearnerActor:
+    """The Model Babbling agent as the study's code asked it (the module's docstring): the
+    model with the nearer experience, a tie to the voice; the arm model asked with the voice
+    model's context values when the voice model had data; the arm at rest when neither had."""
+
+    def __init__(self, agent: Agent) -> None:
+        self.agent = agent
+
+    def choose(self, toy: int, context: np.ndarray, goal: np.ndarray) -> Choice:
+        agent, name = self.agent, TOYS[toy - 1]
+        arm, voice = agent.toy_models(toy)
+        d_arm = agent.nearest_distance(arm, context, goal)
+        d_voice = agent.nearest_distance(voice, context, goal)
+        if d_arm < d_voice:
+            asked = context if np.isinf(d_voice) else _arm_context_of_the_study(context, name)
+            return Choice("arm", agent.exploit(arm, asked, goal), d_arm, d_voice)
+        if np.isfinite(d_voice):
+            return Choice("voice", agent.exploit(voice, context, goal), d_arm, d_voice)
+        return Choice("arm", np.zeros(MOTOR_DIMS["arm"]), d_arm, d_voice, untrained=True)
+
+
 def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
+    """`study_tests_of` the Model Babbling agent as the study asked it (`StudyLearnerActor`)."""
+    return study_tests_of(StudyLearnerActor(agent), room, settings)
+
+
+def study_tests_of(actor: Actor, room: Playroom, settings: StudyMeasureSettings) -> pd.DataFrame:
     """One row per test: ring, toy, x, y (the toy's position), strategy, stick_dx (the stick's
     x at the last sample minus at the first, m), error, stick_contact and goal_moved_by
-    (`movement_contacts`)."""
+    (`movement_contacts`). The scene carries over from test to test; the actor only chooses
+    (actors.py)."""
     rng = np.random.default_rng([settings.seed, room.seed])
     rows = []
     for ring_number, ring in enumerate(room.config.toy_rings, start=1):
@@ -87,18 +115,8 @@ def study_tests(agent: Agent, room: Playroom, settings: StudyMeasureSettings) ->
                 context = room.context()
                 position = context[list(context_indices(toy))]
                 goal = goal_trajectory(position)
-                arm, voice = agent.toy_models(t)
-                d_arm = agent.nearest_distance(arm, context, goal)
-                d_voice = agent.nearest_distance(voice, context, goal)
-                if d_arm < d_voice:
-                    asked = (
-                        context if np.isinf(d_voice) else _arm_context_of_the_study(context, toy)
-                    )
-                    space, m = "arm", agent.exploit(arm, asked, goal)
-                elif np.isfinite(d_voice):
-                    space, m = "voice", agent.exploit(voice, context, goal)
-                else:  # neither model has data: the arm at rest
-                    space, m = "arm", np.zeros(MOTOR_DIMS["arm"])
+                choice = actor.choose(t, context, goal)
+                space, m = choice.motor_space, choice.command
                 feedback = room.act(space, m)
                 s = feedback.s
                 stick_contact, goal_moved_by = movement_contacts(feedback.events, toy)

@@ -15,6 +15,8 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from experiments import manifest, provenance, storage
 from experiments.eval_worlds import OWN, EvalWorldError, own_world, world_record
 from experiments.file_names import (
@@ -25,13 +27,18 @@ from experiments.file_names import (
     VOCAL_FILE,
     eval_world_dir,
 )
+from experiments.measure.actors import Actor, LearnerActor
 from experiments.measure.evaluation import (
     EvaluationSettings,
-    competence_table,
+    competence_of,
     summarise_trial,
     vocal_table,
 )
-from experiments.measure.study_measure import StudyMeasureSettings, study_tests
+from experiments.measure.study_measure import (
+    StudyLearnerActor,
+    StudyMeasureSettings,
+    study_tests_of,
+)
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.trial_checks import is_litter, load_trial, remove_litter
 from experiments.run.trial_files import TrialError, TrialLocked, fresh_trial_parts
@@ -84,35 +91,19 @@ def evaluate_trial(
             (out_dir / name).unlink(missing_ok=True)
         if litter and notify is not None:
             notify(f"removed {len(litter)} temporary file(s) of a killed writer in {out_dir}")
-        # The study's measure starts from it too: the scene learning left, or in another
-        # world, that world's start scene.
-        final_state = room.get_state()
-        competence = competence_table(agent, room, settings, progress=progress)
-        vocal = vocal_table(meta["best_word_distance"], room.words.names)
-        summary = summarise_trial(config, competence, vocal)
-        summary["evaluated_at_iteration"] = int(meta["iteration"])
-        summary["n_placements"] = settings.n_placements
-        # The evaluation is computed too: its numbers carry the machine's bits as well.
-        summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
+        summary, tables = measured(
+            LearnerActor(agent),
+            StudyLearnerActor(agent),
+            room,
+            settings,
+            config,
+            meta["best_word_distance"],
+            int(meta["iteration"]),
+            progress,
+        )
         if out_dir != trial_dir:
             summary["eval_world"] = world_record(config, world)
-        # The study measured in the scene its tests start from (above), carried over from
-        # test to test.
-        room.set_state(final_state)
-        study = study_tests(agent, room, StudyMeasureSettings(settings.n_placements))
-        # eval.json last: it vouches for the tables (storage.write_files). A word's best
-        # distance (and so a median) is infinite until the trial's first voice movement:
-        # eval.json, standard JSON, holds null for it (experiments/analysis/results.py reads it
-        # back as infinity). The summary returned keeps the numbers.
-        files = {
-            COMPETENCE_FILE: storage.table_bytes(competence),
-            VOCAL_FILE: storage.table_bytes(vocal),
-            STUDY_TESTS_FILE: storage.table_bytes(study),
-        }
-        # eval.json lists the tables it vouches for, with their sizes and checksums, so that
-        # a reader refuses a table lost, damaged or left from another evaluation.
-        summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(files)
-        files[EVAL_FILE] = storage.json_bytes(storage.finite_or_null(summary))
+        files = evaluation_files(summary, tables)
         storage.write_files(out_dir, files)
     finally:
         lock.release()
@@ -145,3 +136,53 @@ def _where_tested(
     trial = {**config["trial"], "grasp": tested["grasp"]}
     _, tested_room = fresh_trial_parts({**config, "trial": trial, "world": tested["world"]})
     return trial_dir / eval_world_dir(world), tested_room
+
+
+def measured(
+    actor: Actor,
+    study_actor: Actor,
+    room: Playroom,
+    settings: EvaluationSettings,
+    config: dict,
+    best_word_distance: np.ndarray,
+    evaluated_at: int,
+    progress: bool = False,
+) -> tuple[dict, dict[str, bytes]]:
+    """(eval.json's numbers, the tables' bytes by file name) of an actor tested in `room` as
+    a trial's final agent is: the project's measure (`competence_of`, `actor`), the vocal
+    table of `best_word_distance` (the best distance of the learner's own sounds to each word,
+    in the order of the voice's words) and the study's tests (`study_tests_of`, `study_actor`),
+    which start from the room's scene as it is now. `config`: the trial's (or a config of its
+    form: its "trial" section's grasp, seed, babbling and iterations are summarised).
+    The same for every learner: only the actors differ."""
+    # The study's measure starts from it too: the scene learning left, or in another world,
+    # that world's start scene.
+    final_state = room.get_state()
+    competence = competence_of(actor, room, settings, progress=progress)
+    vocal = vocal_table(best_word_distance, room.words.names)
+    summary = summarise_trial(config, competence, vocal)
+    summary["evaluated_at_iteration"] = int(evaluated_at)
+    summary["n_placements"] = settings.n_placements
+    # The evaluation is computed too: its numbers carry the machine's bits as well.
+    summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
+    # The study measured in the scene its tests start from (above), carried over from test to
+    # test.
+    room.set_state(final_state)
+    study = study_tests_of(study_actor, room, StudyMeasureSettings(settings.n_placements))
+    tables = {
+        COMPETENCE_FILE: storage.table_bytes(competence),
+        VOCAL_FILE: storage.table_bytes(vocal),
+        STUDY_TESTS_FILE: storage.table_bytes(study),
+    }
+    return summary, tables
+
+
+def evaluation_files(summary: dict, tables: dict[str, bytes]) -> dict[str, bytes]:
+    """The files of an evaluation, eval.json last: it vouches for the tables
+    (storage.write_files). eval.json lists the tables with their sizes and checksums, so that a
+    reader refuses a table lost, damaged or left from another evaluation. A word's best
+    distance (and so a median) is infinite until the learner's first voice movement: eval.json,
+    standard JSON, holds null for it (experiments/analysis/results.py reads it back as
+    infinity); `summary` itself keeps the numbers."""
+    summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(tables)
+    return {**tables, EVAL_FILE: storage.json_bytes(storage.finite_or_null(summary))}

@@ -1,0 +1,92 @@
+"""Deep-RL baseline runs (`playroom rl-baseline`, experiments/baseline/) read into the tables a
+batch of trials is read into (results.py): one row per run in `trials` (eval.json's numbers:
+competence_all, competence_ring1..3, mean errors, vocal numbers), the rows of its
+competence.parquet, vocal.parquet and study-tests.parquet, each labelled with its run
+(`trial`, the directory name), `group` (the grasp) and `seed`, every table checked against
+eval.json's list of files. A run has no logs: no curves, no mechanisms. The tables have a
+trial's columns, so that the statistics over trials (trial_values.py, trial_tests.py) pair a
+baseline's runs with Model Babbling's trials by seed."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from experiments.analysis.results import (
+    ReportError,
+    _eval_numbers,
+    _evaluation_table,
+    _read_json,
+)
+from experiments.file_names import (
+    BASELINE_FILE,
+    COMPETENCE_FILE,
+    EVAL_FILE,
+    STUDY_TESTS_FILE,
+    VOCAL_FILE,
+)
+
+
+@dataclass(frozen=True)
+class BaselineResults:
+    """Every table of a folder of baseline runs (the module's docstring)."""
+
+    runs_dir: Path
+    trials: pd.DataFrame
+    competence: pd.DataFrame
+    vocal: pd.DataFrame
+    study_tests: pd.DataFrame
+
+
+def is_baseline_dir(directory: Path) -> bool:
+    return (directory / BASELINE_FILE).is_file()
+
+
+def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
+    """Read every run of a folder (`playroom rl-baseline --config ... --out DIR`'s DIR) into
+    tables. ReportError (one line) for a folder without runs, a run not evaluated, or a table
+    missing or damaged."""
+    root = Path(runs_dir)
+    if not root.is_dir():
+        raise ReportError(f"{root} is not a directory")
+    dirs = sorted(d for d in root.iterdir() if d.is_dir() and is_baseline_dir(d))
+    if not dirs:
+        raise ReportError(f"no baseline runs found in {root} (folders holding {BASELINE_FILE})")
+    unfinished = [d.name for d in dirs if not (d / EVAL_FILE).is_file()]
+    if unfinished:
+        raise ReportError(
+            f"{len(unfinished)} of {len(dirs)} runs in {root} are not finished (no {EVAL_FILE}): "
+            f"{', '.join(unfinished[:5])}; run the same `playroom rl-baseline` command again"
+        )
+    trials: list[dict] = []
+    tables: dict[str, list[pd.DataFrame]] = {
+        name: [] for name in (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
+    }
+    for d in dirs:
+        summary = _read_json(d / EVAL_FILE)
+        if not isinstance(summary, dict) or "grasp" not in summary or "seed" not in summary:
+            raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
+        keys = {"trial": d.name, "group": summary["grasp"], "seed": summary["seed"]}
+        trials.append(
+            {
+                **keys,
+                "path": str(d),
+                "grasp": summary["grasp"],
+                "babbling": summary.get("babbling"),
+                "iterations": summary.get("iterations"),
+                "n_placements": summary.get("n_placements"),
+                **_eval_numbers(d, summary),
+            }
+        )
+        for name, rows in tables.items():
+            rows.append(_evaluation_table(d / name, summary).assign(**keys))
+    return BaselineResults(
+        runs_dir=root,
+        trials=pd.DataFrame(trials),
+        competence=pd.concat(tables[COMPETENCE_FILE], ignore_index=True),
+        vocal=pd.concat(tables[VOCAL_FILE], ignore_index=True),
+        study_tests=pd.concat(tables[STUDY_TESTS_FILE], ignore_index=True),
+    )
