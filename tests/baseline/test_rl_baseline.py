@@ -8,15 +8,11 @@ from __future__ import annotations
 
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
-
-# The rl extra's one skip-or-fail rule, from where the environments' checks keep it.
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim" / "envs"))
-from rl_extra import require_stable_baselines3  # noqa: E402
+from rl_extra import require_stable_baselines3
 
 require_stable_baselines3()
 
