@@ -24,6 +24,10 @@ from experiments.report.pages import p_value, seeds_text
 
 FILES = ("ladder.csv", "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}
+WORLDS_TABLE_TITLE = (
+    "Every rung's agents in each world (normalised competence, mean over the trials of the "
+    "seeds every rung holds, trials in brackets):"
+)
 PART_TEXT = {
     "learned": "learned (both rungs' agents tested in the {world} world)",
     "worlds": "the test worlds (own against the {world} world, B's change minus A's)",
@@ -160,7 +164,7 @@ def split_table(splits: pd.DataFrame, levels: pd.DataFrame) -> list[str]:
         )
         part = PART_TEXT[case["part"]].format(world=case["world"])
         lines.append(f"| {step} | {part} | " + " | ".join(cells) + " |")
-    lines += ["", "Every rung's agents in each world (normalised competence, mean over trials):"]
+    lines += ["", WORLDS_TABLE_TITLE]
     lines += ["", "| rung | tested in | " + " | ".join(HEAD[k] for k in keys) + " |"]
     lines.append("|---" * (len(keys) + 2) + "|")
     for case in levels[["rung", "tested"]].drop_duplicates().to_dict("records"):
@@ -228,7 +232,9 @@ def write_ladder(
     steps = ladder.step_tests(values, order, others, measures)
     splits = ladder.split_tests(values, order, others)
     steps, splits = ladder.with_holm(steps, splits)
-    levels = ladder.levels(values)
+    # The rungs' means on the seeds the steps pair, so that the first plus the steps is the last.
+    common = ladder.common_seeds(values, order)
+    levels = ladder.levels(values[values["seed"].isin(common) | values["rung"].isin(others)])
     page = markdown(command, rungs, beside, own, measures, steps, splits, levels, missing)
     record = {
         "command": command,
@@ -239,6 +245,7 @@ def write_ladder(
         "steps": _records(steps),
         "splits": _records(splits),
         "steps_sum": _records(ladder.steps_sum(steps)),
+        "levels": _records(levels),
         "not_tested": missing,
     }
     tests = pd.concat([steps.assign(part="step"), splits], ignore_index=True)

@@ -169,3 +169,16 @@ def test_the_whole_on_every_seed_is_shown_only_where_the_ends_share_more_seeds()
     values = _values(LEVELS, drop=("C", 3))  # the last rung lacks a seed: nothing more to say
     steps = ladder.step_tests(values, ["A", "B", "C"], [], _headline())
     assert "whole_all" not in set(steps["kind"])
+
+
+def test_the_rungs_means_are_over_the_seeds_the_steps_pair(batches, tmp_path):
+    """The first rung's mean plus the steps is the last rung's: both on the seeds every rung
+    holds (the kinematic batch holds seeds 0 and 1, the physical one seed 0 only)."""
+    rungs = [f"a={batches['kinematic']}", f"b={batches['physical']}"]
+    assert main(["ladder", *rungs, "--out", str(tmp_path / "out")]) == 0
+    record = json.loads((tmp_path / "out" / "ladder.json").read_text())
+    own = [lv for lv in record["levels"] if lv["tested"] == "own"]
+    assert {lv["n"] for lv in own if lv["rung"] == "a"} == {1}
+    (step,) = [s for s in record["steps"] if s["key"] == "competence_all" and s["kind"] == "step"]
+    mean = {lv["rung"]: lv["mean"] for lv in own if lv["key"] == "competence_all"}
+    assert mean["a"] + step["mean"] == pytest.approx(mean["b"])
