@@ -112,6 +112,10 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
     check_explained(text, n_trials_warned=True)
     assert "Welch t" in text and "Mann-Whitney U" in text and "χ²" in text
     assert "not recorded" in text and "5.00 ms / iteration" in text
+    # In which rules the two worlds differ besides the grasp (tests/report/test_backend_rules.py).
+    assert re.search(r"differ in more than the grasp rule: kinematic .*world\.catch_rule", text)
+    summary = json.loads((out / "summary.json").read_text())
+    assert "catch_rule" in summary["backend_rules"]["kinematic"]
     # The stick as a tool, per backend: in reach, grasps, catches, returns, held or pushed.
     for statistic in (
         "Iterations that began with the stick within reach",
