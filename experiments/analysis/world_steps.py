@@ -27,6 +27,7 @@ import pandas as pd
 from scipy import stats
 
 from experiments import storage
+from experiments.analysis import trial_tests
 from experiments.analysis.cross_worlds import RINGS, STRATEGIES, tested_in
 from experiments.analysis.logs import trial_dirs
 from experiments.file_names import EVAL_FILE, EVALUATION_TABLES
@@ -120,13 +121,8 @@ def _own_world(table: pd.DataFrame, condition: str) -> str | None:
 
 
 def holm(p: pd.Series) -> pd.Series:
-    """Holm's step-down adjusted p-values (NaN left out)."""
-    order = p.dropna().sort_values()
-    m, running, adjusted = len(order), 0.0, {}
-    for i, (index, value) in enumerate(order.items()):
-        running = max(running, min(1.0, (m - i) * value))
-        adjusted[index] = running
-    return pd.Series(adjusted).reindex(p.index)
+    """Holm's step-down adjusted p-values (NaN left out): trial_tests.holm, by index."""
+    return pd.Series(trial_tests.holm(p.to_numpy(dtype=float)), index=p.index)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -155,6 +155,13 @@ def common_seeds(values: pd.DataFrame, order: list[str]) -> set[int]:
     return set.intersection(*(set(values.loc[values["rung"] == r, "seed"]) for r in order))
 
 
+def _steps(order: list[str], beside: list[str]) -> list[tuple[str, str, str]]:
+    """(kind, from, to) of every comparison the page makes: each step, the whole (first rung to
+    last) and each rung beside the ladder against the last rung."""
+    steps = [(STEP, a, b) for a, b in pairwise(order)]
+    return [*steps, (WHOLE, order[0], order[-1]), *((BESIDE, order[-1], r) for r in beside)]
+
+
 def step_tests(
     values: pd.DataFrame, order: list[str], beside: list[str], measures: list[Headline]
 ) -> pd.DataFrame:
@@ -162,11 +169,11 @@ def step_tests(
     rung to last), on the seeds every rung holds, so that the steps' sum is the whole wherever
     no value is missing; the whole on every seed the first and last rungs hold (WHOLE_ALL),
     where they hold more; and each rung beside the ladder against the last rung."""
-    ladder = values[values["seed"].isin(common_seeds(values, order))]
-    pairs = [(STEP, a, b, ladder) for a, b in pairwise(order)]
-    pairs.append((WHOLE, order[0], order[-1], ladder))
+    common = common_seeds(values, order)
+    ladder = values[values["seed"].isin(common)]
+    pairs = [(kind, a, b, ladder) for kind, a, b in _steps(order, [])]
     ends = [set(values.loc[values["rung"] == r, "seed"]) for r in (order[0], order[-1])]
-    if len(ends[0] & ends[1]) > len(common_seeds(values, order)):
+    if len(ends[0] & ends[1]) > len(common):
         pairs.append((WHOLE_ALL, order[0], order[-1], values))
     pairs += [(BESIDE, order[-1], r, values) for r in beside]
     rows = []
@@ -181,13 +188,10 @@ def split_tests(values: pd.DataFrame, order: list[str], beside: list[str]) -> pd
     """Each step (and the whole difference, and each rung beside) of each competence measure
     split, in each test world both rungs' agents were tested in, into `learned` and `worlds`
     (module docstring); steps whose rungs lack a test world are left out."""
-    pairs = [(STEP, a, b) for a, b in pairwise(order)]
-    pairs.append((WHOLE, order[0], order[-1]))
-    pairs += [(BESIDE, order[-1], r) for r in beside]
     values = values[values["seed"].isin(common_seeds(values, order)) | values["rung"].isin(beside)]
     rows = []
     for key in COMPETENCE:
-        for kind, a, b in pairs:
+        for kind, a, b in _steps(order, beside):
             for world in WORLDS:
                 a_in, b_in = _series(values, a, key, world), _series(values, b, key, world)
                 if a_in.empty or b_in.empty:
