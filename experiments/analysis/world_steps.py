@@ -122,7 +122,7 @@ def _own_world(table: pd.DataFrame, condition: str) -> str | None:
 
 def holm(p: pd.Series) -> pd.Series:
     """Holm's step-down adjusted p-values (NaN left out): trial_tests.holm, by index."""
-    return pd.Series(trial_tests.holm(p.to_numpy(dtype=float)), index=p.index)
+    return pd.Series(trial_tests.holm(p.astype(float).tolist()), index=p.index)
 
 
 def main(argv: list[str] | None = None) -> None:
