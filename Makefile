@@ -169,12 +169,15 @@ $(RL_INSTALLED): $(INSTALLED)
 ## batch of experiments/batches/rl-baseline/comparison.json (both backends, 8 seeds x 20000
 ## iterations), then for each of its trials SAC + HER (stable-baselines3's defaults) given as
 ## many movements and tested the same way (`playroom rl-baseline --config`, on every core;
-## docs/rl-baseline.md); installs the `rl` extra; rerunning resumes
+## docs/rl-baseline.md), then the page pairing the two by seed (`playroom rl-compare`);
+## installs the `rl` extra; rerunning resumes
 RL_BASELINE := experiments/batches/rl-baseline/comparison.json
 rl-baseline: $(RL_INSTALLED)
 	$(BIN)/playroom batch --config $(RL_BASELINE) --out $(OUT)/rl-baseline/model-babbling
 	$(BIN)/playroom report $(OUT)/rl-baseline/model-babbling
 	$(BIN)/playroom rl-baseline --config $(RL_BASELINE) --out $(OUT)/rl-baseline/sac-her
+	$(BIN)/playroom rl-compare $(OUT)/rl-baseline/model-babbling $(OUT)/rl-baseline/sac-her \
+		--out $(OUT)/rl-baseline/page
 
 ## test-slow: the longer checks marked `slow` (with the `rl` extra installed: those checks fail
 ## rather than skip without it), then the whole suite with another CPU emulated

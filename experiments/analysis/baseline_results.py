@@ -15,7 +15,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from experiments.analysis.batch_checks import shared_config
 from experiments.analysis.results import (
+    BatchResults,
     ReportError,
     _eval_numbers,
     _evaluation_table,
@@ -28,6 +30,7 @@ from experiments.file_names import (
     STUDY_TESTS_FILE,
     VOCAL_FILE,
 )
+from experiments.provenance import SHORT_FIELDS, short_record
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,24 @@ class BaselineResults:
     competence: pd.DataFrame
     vocal: pd.DataFrame
     study_tests: pd.DataFrame
+    configs: dict[str, dict]  # grasp -> the trials' world the runs learned in (seed removed)
+    # Where each run was computed (baseline.json's `created_on`): role 'computed',
+    # provenance.SHORT_FIELDS, as BatchResults.provenance holds a trial's.
+    provenance: pd.DataFrame
+
+    def as_batch(self) -> BatchResults:
+        """The runs as a batch's results (no curves: a run has no logs), so that every
+        per-trial measure of the registry (experiments/report/measures.py) reads them."""
+        return BatchResults(
+            batch_dir=self.runs_dir,
+            trials=self.trials,
+            competence=self.competence,
+            vocal=self.vocal,
+            curves=pd.DataFrame(columns=["trial", "group", "seed", "iteration", "metric", "value"]),
+            configs=self.configs,
+            study_tests=self.study_tests,
+            provenance=self.provenance,
+        )
 
 
 def is_baseline_dir(directory: Path) -> bool:
@@ -65,11 +86,25 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
     tables: dict[str, list[pd.DataFrame]] = {
         name: [] for name in (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
     }
+    configs: dict[str, dict] = {}
+    where = []
     for d in dirs:
         summary = _read_json(d / EVAL_FILE)
         if not isinstance(summary, dict) or "grasp" not in summary or "seed" not in summary:
             raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
         keys = {"trial": d.name, "group": summary["grasp"], "seed": summary["seed"]}
+        recorded = _read_json(d / BASELINE_FILE)
+        config = recorded.get("trial") if isinstance(recorded, dict) else None
+        if not isinstance(config, dict):
+            raise ReportError(f"{d / BASELINE_FILE} lacks the trial's config: run it again")
+        if configs.setdefault(summary["grasp"], shared_config(config)) != shared_config(config):
+            raise ReportError(
+                f"{d.name}: its world differs from the other {summary['grasp']} runs' in {root}"
+            )
+        created = short_record(recorded.get("created_on"))
+        status = "not recorded" if created is None else "recorded"
+        fields = created or dict.fromkeys(SHORT_FIELDS, "")
+        where.append({**keys, "role": "computed", "from_iteration": 0, "status": status, **fields})
         trials.append(
             {
                 **keys,
@@ -89,4 +124,6 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
         competence=pd.concat(tables[COMPETENCE_FILE], ignore_index=True),
         vocal=pd.concat(tables[VOCAL_FILE], ignore_index=True),
         study_tests=pd.concat(tables[STUDY_TESTS_FILE], ignore_index=True),
+        configs=configs,
+        provenance=pd.DataFrame(where),
     )

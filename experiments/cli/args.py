@@ -105,3 +105,21 @@ def version_text() -> str:
     source = source_record()
     where = ("commit " if source.get("commit") else "") + commit_text(source)
     return f"playroom {version('playroom')} ({where})"
+
+
+def study_reference_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--study-reference-commands",
+        type=positive_int,
+        metavar="N",
+        help="random commands per ring behind the study's own measure (default: the batch's "
+        "study_reference_commands, which its profile sets: the study's 30000, 10000 placements "
+        "x 3 toys, at the study's scale, fewer for smoke and demo)",
+    )
+    p.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="processes playing the study's random reference when it is not kept yet "
+        "(default: cores; the numbers do not depend on it)",
+    )

@@ -251,7 +251,7 @@ def cmd_report(args: argparse.Namespace) -> None:
     from experiments.report.batch_report import write_report
 
     try:
-        print(write_report(args.dir, args.out, **_study_reference(args, [args.dir])))
+        print(write_report(args.dir, args.out, **study_reference(args, [args.dir])))
     except ReportError as exc:
         raise UsageError(str(exc)) from None
 
@@ -267,7 +267,7 @@ def cmd_compare(args: argparse.Namespace) -> None:
                 args.dir_a,
                 args.dir_b,
                 args.out,
-                **_study_reference(args, [args.dir_a, args.dir_b]),
+                **study_reference(args, [args.dir_a, args.dir_b]),
                 **_grasp_rate_commands(args),
             )
         )
@@ -283,7 +283,7 @@ def cmd_ablations(args: argparse.Namespace) -> None:
     try:
         dirs = [args.baseline, *args.batches]
         table = write_ablations(
-            args.baseline, args.batches, args.out, **_study_reference(args, dirs)
+            args.baseline, args.batches, args.out, **study_reference(args, dirs)
         )
     except ReportError as exc:
         raise UsageError(str(exc)) from None
@@ -343,7 +343,7 @@ def _grasp_rate_commands(args: argparse.Namespace) -> dict:
     return {} if n is None else {"grasp_rate_commands": n}
 
 
-def _study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
+def study_reference(args: argparse.Namespace, batch_dirs: list[str]) -> dict:
     """The room measures a report shows (measured here, by the measuring stage: a report
     builds no room), with the reference size asked for, else the one the batches record (their
     profile's), else the study's (experiments.analysis.study_summary), played on the processes

@@ -11,7 +11,7 @@ import textwrap
 
 from experiments.batches.stored import stored_profiles
 from experiments.bench.names import ON_REQUEST, SECTION_HELP, SECTION_NAMES
-from experiments.cli import ladder_command, rl_command
+from experiments.cli import ladder_command, rl_command, rl_compare_command
 from experiments.cli.args import (
     Parser,
     VersionAction,
@@ -19,6 +19,7 @@ from experiments.cli.args import (
     non_negative_int,
     positive_int,
     run_default,
+    study_reference_option,
 )
 from experiments.cli.commands import (
     cmd_ablations,
@@ -44,24 +45,6 @@ from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import STICK_RETURNS
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
 from sim.vocal.config import DEFAULT_VOICE
-
-
-def _study_reference_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--study-reference-commands",
-        type=positive_int,
-        metavar="N",
-        help="random commands per ring behind the study's own measure (default: the batch's "
-        "study_reference_commands, which its profile sets: the study's 30000, 10000 placements "
-        "x 3 toys, at the study's scale, fewer for smoke and demo)",
-    )
-    p.add_argument(
-        "--workers",
-        type=positive_int,
-        metavar="N",
-        help="processes playing the study's random reference when it is not kept yet "
-        "(default: cores; the numbers do not depend on it)",
-    )
 
 
 def _set_option(p: argparse.ArgumentParser, what: str) -> None:
@@ -200,7 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="figures and report.html of a batch beside the paper")
     p.add_argument("dir", help="a batch directory of evaluated trials")
     p.add_argument("--out", help="where to write (default: DIR)")
-    _study_reference_option(p)
+    study_reference_option(p)
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("compare", help="kinematic vs physical batches side by side")
@@ -214,18 +197,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="random arm commands played in each backend for the stick's grasp rates "
         "(default: the comparison's own, which the page states)",
     )
-    _study_reference_option(p)
+    study_reference_option(p)
     p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("ablations", help="batches changing a setting, against a baseline")
     p.add_argument("baseline", help="the baseline batch directory (e.g. the replication)")
     p.add_argument("batches", nargs="+", help="batch directories, each changing a setting")
     p.add_argument("--out", required=True, help="where to write ablations.md/.csv/.png")
-    _study_reference_option(p)
+    study_reference_option(p)
     p.set_defaults(func=cmd_ablations)
 
     ladder_command.add_parser(sub)
     rl_command.add_parser(sub)
+    rl_compare_command.add_parser(sub)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")

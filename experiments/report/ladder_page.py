@@ -20,7 +20,7 @@ from experiments.report import ladder
 from experiments.report.ablations import describe_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
-from experiments.report.pages import p_value, seeds_text
+from experiments.report.pages import machines_text, p_value, seeds_text
 
 FILES = ("ladder.csv", "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}
@@ -34,7 +34,7 @@ PART_TEXT = {
 }
 
 
-def _signed(kind: str, x: float) -> str:
+def signed_text(kind: str, x: float) -> str:
     if not math.isfinite(x):
         return "n/a"
     return (
@@ -47,7 +47,7 @@ def _signed(kind: str, x: float) -> str:
 
 
 def _level(kind: str, x: float) -> str:
-    return _signed(kind, x).lstrip("+")
+    return signed_text(kind, x).lstrip("+")
 
 
 def _cell(kind: str, row: dict) -> str:
@@ -55,8 +55,8 @@ def _cell(kind: str, row: dict) -> str:
     n = int(row["n"])
     if not math.isfinite(row["mean"]):
         return f"n/a ({n} pairs)"
-    low, high = _signed(kind, row["low"]), _signed(kind, row["high"])
-    text = f"{_signed(kind, row['mean'])} [{low}, {high}]"
+    low, high = signed_text(kind, row["low"]), signed_text(kind, row["high"])
+    text = f"{signed_text(kind, row['mean'])} [{low}, {high}]"
     if not math.isfinite(row["p"]):
         return f"{text}, untested: every pair equal ({n})"
     mark = " *" if survives(row["p_holm"]) else ""
@@ -69,15 +69,6 @@ def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[d
     for column, value in {**(where or {}), **also}.items():
         mask &= table[column] == value
     return [dict(r) for r in table[mask].to_dict("records")]
-
-
-def _machines(results: BatchResults) -> str:
-    where = results.provenance
-    if "status" not in where or where.empty:
-        return "not recorded"
-    computed = where[where["role"] == "computed"]
-    found = computed.drop_duplicates(["cpu", "commit"])
-    return "; ".join(f"{r.cpu}, commit {r.commit}" for r in found.itertuples())
 
 
 def _change(before: dict, config: dict) -> str:
@@ -107,7 +98,7 @@ def rungs_table(rungs: list[ladder.Rung], own: dict[str, BatchResults]) -> list[
         seeds = sorted(int(s) for s in results.trials["seed"])
         lines.append(
             f"| {rung.name} | {rung.batch_dir.name} ({group}) | {change} | "
-            f"{len(seeds)} ({seeds_text(seeds)}) | {_machines(results)} |"
+            f"{len(seeds)} ({seeds_text(seeds)}) | {machines_text(results)} |"
         )
         before = config
     return lines
@@ -139,8 +130,8 @@ def steps_table(
         s = sums[h.key]
         inside = "within" if s["within"] else "outside"
         cells.append(
-            f"{_signed(kind, s['steps_sum'])} ({_signed(kind, s['whole_minus_sum'])}; {inside} "
-            "the whole's interval)"
+            f"{signed_text(kind, s['steps_sum'])} "
+            f"({signed_text(kind, s['whole_minus_sum'])}; {inside} the whole's interval)"
         )
         for which in (ladder.WHOLE_ALL, ladder.BESIDE):
             cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=which)]
@@ -209,7 +200,7 @@ def markdown(command: str, rungs, beside, own, measures, steps, splits, levels, 
     return "\n".join(lines) + "\n"
 
 
-def _records(table: pd.DataFrame) -> list[dict]:
+def json_records(table: pd.DataFrame) -> list[dict]:
     """A table's rows for JSON: a value that is not finite (no test, no value) as null."""
     return [
         {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
@@ -241,11 +232,11 @@ def write_ladder(
         "rungs": [{"name": r.name, "batch": str(r.batch_dir), "group": r.group} for r in rungs],
         "beside": [{"name": r.name, "batch": str(r.batch_dir), "group": r.group} for r in beside],
         "measures": {h.key: {"label": h.label, "kind": h.measure.kind} for h in measures},
-        "values": _records(values),
-        "steps": _records(steps),
-        "splits": _records(splits),
-        "steps_sum": _records(ladder.steps_sum(steps)),
-        "levels": _records(levels),
+        "values": json_records(values),
+        "steps": json_records(steps),
+        "splits": json_records(splits),
+        "steps_sum": json_records(ladder.steps_sum(steps)),
+        "levels": json_records(levels),
         "not_tested": missing,
     }
     tests = pd.concat([steps.assign(part="step"), splits], ignore_index=True)

@@ -101,6 +101,17 @@ def shares_text(row: pd.Series) -> str:
     return f"{shares} (n={row['n']} tests)"
 
 
+def machines_text(results: BatchResults) -> str:
+    """Where a batch's trials were computed, each CPU and commit once ("AMD EPYC, commit
+    abc1234; ...")."""
+    where = results.provenance
+    if "status" not in where or where.empty:
+        return "not recorded"
+    computed = where[where["role"] == "computed"]
+    found = computed.drop_duplicates(["cpu", "commit"])
+    return "; ".join(f"{r.cpu}, commit {r.commit}" for r in found.itertuples())
+
+
 def seeds_text(seeds: list[int]) -> str:
     """Seeds as a range ("0–9") when they are consecutive, else listed."""
     seeds = sorted(seeds)

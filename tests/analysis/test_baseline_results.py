@@ -5,43 +5,19 @@ refused in one line. The runs here are written by the evaluation a baseline's ru
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
+from baseline_runs import write_run
 
-from experiments import storage
 from experiments.analysis.baseline_results import collect_baselines
 from experiments.analysis.results import ReportError
-from experiments.baseline.settings import BaselineSettings, run_name, summary_config, trial_config
-from experiments.file_names import BASELINE_FILE, COMPETENCE_FILE, EVAL_FILE
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.policy_actor import PolicyActor
-from experiments.measure.trial_evaluation import evaluation_files, measured
-from experiments.run.trial_files import fresh_trial_parts
-
-
-class RestingPolicy:
-    def predict(self, observation, deterministic=False):
-        action = np.zeros(50, dtype=np.float32)
-        action[0] = -1.0  # the arm, at rest
-        return action, None
-
-
-def _write_run(root, seed: int) -> None:
-    settings = BaselineSettings(steps=30, seed=seed, eval_placements=1)
-    _, room = fresh_trial_parts(trial_config(settings))
-    actor = PolicyActor({t: RestingPolicy() for t in (1, 2, 3)})
-    summary, tables = measured(
-        actor, actor, room, EvaluationSettings(1), summary_config(settings), np.full(6, np.inf), 30
-    )
-    out = root / run_name(settings)
-    record = storage.json_bytes({"settings": settings.record()})
-    storage.write_files(out, {BASELINE_FILE: record, **evaluation_files(summary, tables)})
+from experiments.baseline.settings import BaselineSettings, run_name
+from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
 
 
 @pytest.fixture
 def runs(tmp_path):
     for seed in (0, 3):
-        _write_run(tmp_path, seed)
+        write_run(tmp_path, seed)
     return tmp_path
 
 
