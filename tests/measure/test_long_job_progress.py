@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from experiments import storage
-from experiments.cli.commands import _study_reference
+from experiments.cli.commands import study_reference
 from experiments.file_names import BATCH_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference
@@ -42,7 +42,7 @@ def test_reports_play_the_reference_the_batch_recorded_unless_asked_otherwise(tm
 
     def size(given: int | None, dirs: list) -> int:
         args = argparse.Namespace(study_reference_commands=given)
-        return _study_reference(args, dirs)["measures"].study_numbers.keywords["commands_per_ring"]
+        return study_reference(args, dirs)["measures"].study_numbers.keywords["commands_per_ring"]
 
     assert size(None, [tmp_path]) == 300
     assert size(10, [tmp_path]) == 10

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from experiments.cli.commands import _study_reference
+from experiments.cli.commands import study_reference
 from experiments.measure.stick import batch_worlds, grasp_rates
 from experiments.run.settings import TrialSettings, full_config
 from experiments.storage import write_json
@@ -29,7 +29,7 @@ def test_the_grasp_rates_of_a_report_play_the_trials_own_world(tmp_path):
     args = argparse.Namespace(study_reference_commands=None, workers=1)
     rates = {}
     for preset in ("study", "project"):
-        measures = _study_reference(args, [str(_batch(tmp_path, preset))])["measures"]
+        measures = study_reference(args, [str(_batch(tmp_path, preset))])["measures"]
         rates[preset] = measures.grasp_rates(COMMANDS, ("kinematic",))["kinematic"]
         world = {"kinematic": dataclasses.asdict(world_preset(preset))}
         played = grasp_rates(COMMANDS, ("kinematic",), progress=False, worlds=world)
