@@ -11,11 +11,17 @@ REQUIRED = "PLAYROOM_RL_REQUIRED"
 
 def require_stable_baselines3() -> None:
     """Skip the calling test module (at its import) where stable-baselines3 is missing."""
-    if importlib.util.find_spec("stable_baselines3") is not None:
+    require("stable_baselines3")
+
+
+def require(module: str) -> None:
+    """Skip the calling test (or test module, at its import) where `module`, one of the `rl`
+    extra's, is missing; fail instead under `make test-slow`."""
+    if importlib.util.find_spec(module) is not None:
         return
     if os.environ.get(REQUIRED):
-        raise ImportError("stable-baselines3 is not installed, and make test-slow requires it")
+        raise ImportError(f"{module} is not installed, and make test-slow requires it")
     pytest.skip(
-        "stable-baselines3 is not installed: `make test-slow` installs it (the `rl` extra)",
+        f"{module} is not installed: `make test-slow` installs it (the `rl` extra)",
         allow_module_level=True,
     )

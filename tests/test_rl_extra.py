@@ -19,11 +19,11 @@ def _dry_run(target: str) -> str:
     ).stdout
 
 
-def test_the_rl_extra_is_stable_baselines_alone():
+def test_the_rl_extra_is_stable_baselines_and_recordvideos_writer_alone():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    assert project["optional-dependencies"]["rl"] == ["stable-baselines3>=2.3"]
+    assert project["optional-dependencies"]["rl"] == ["stable-baselines3>=2.3", "moviepy>=1.0.3,<2"]
     others = project["dependencies"] + project["optional-dependencies"]["dev"]
-    assert not [d for d in others if d.startswith(("stable-baselines3", "torch"))]
+    assert not [d for d in others if d.startswith(("stable-baselines3", "torch", "moviepy"))]
 
 
 def test_only_make_test_slow_installs_it_and_requires_its_checks_to_run():
@@ -72,7 +72,7 @@ def test_the_rl_extra_is_pinned_like_everything_else():
         for line in (ROOT / "constraints.txt").read_text().splitlines()
         if "==" in line
     }
-    assert {"stable-baselines3", "torch"} <= {p.replace("_", "-") for p in pins}
+    assert {"stable-baselines3", "torch", "moviepy"} <= {p.replace("_", "-") for p in pins}
     (torch,) = [line for line in (ROOT / "constraints.txt").read_text().splitlines()
                 if line.startswith("torch==")]  # fmt: skip
     assert torch.endswith("+cpu")

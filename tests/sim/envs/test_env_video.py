@@ -10,10 +10,12 @@ import sys
 import types
 
 import gymnasium
+import imageio_ffmpeg
 import mujoco
 import numpy as np
 import pytest
 from gymnasium.wrappers import RecordVideo
+from rl_extra import require
 from scripted import Waypoint, arm_command_through
 
 from experiments.video.overlay import CameraView
@@ -79,6 +81,30 @@ def test_a_recorded_video_shows_the_arm_where_its_movement_took_it(recorded_clip
     at_reset, after_step = frames
     assert np.linalg.norm(hand - HAND_END) < 0.02
     assert _arm_near(after_step, uv) and not _arm_near(at_reset, uv)
+
+
+@pytest.mark.slow  # MoviePy (the `rl` extra) encodes the clip through ffmpeg
+def test_recordvideos_own_writer_files_a_clip_of_the_arm_moving(tmp_path):
+    require("moviepy")
+
+    env = gymnasium.make(GYM_ID, grasp="physical", render_mode="rgb_array", render_size=SIZE)
+    env = RecordVideo(
+        env, str(tmp_path / "videos"), episode_trigger=lambda _: True, disable_logger=True
+    )
+    env.reset(seed=0)
+    room = env.unwrapped.movement_env.room
+    env.step(_arm_action(room.config))
+    hand = env.unwrapped.movement_env.last_feedback.positions[-1, 0]
+    model, data = room.physics.model.ptr, room.physics.data.ptr
+    height = data.geom_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "hand"), 2]
+    uv = CameraView.of(model, data, "top", *SIZE).project(np.r_[hand, height])[0]
+    env.close()
+    (clip,) = (tmp_path / "videos").glob("*.mp4")
+    reader = imageio_ffmpeg.read_frames(str(clip))  # the MP4 file, decoded
+    width, height = next(reader)["size"]
+    frames = [np.frombuffer(f, np.uint8).reshape(height, width, 3) for f in reader]
+    assert (width, height) == SIZE and len(frames) == 2
+    assert _arm_near(frames[1], uv) and not _arm_near(frames[0], uv)
 
 
 def test_a_frame_after_a_step_made_before_any_render_says_what_it_shows():
