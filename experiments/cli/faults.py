@@ -145,6 +145,9 @@ KEPT: dict[str, Callable[[argparse.Namespace, list[str], str], str]] = {
     "ablations": _nothing_written,
     "ladder": _nothing_written,
     "rl-baseline": _baseline_kept,
+    "rl-compare": _nothing_written,
+    "replay": _nothing_written,
+    "voice-memory": _nothing_written,
 }
 
 

@@ -11,7 +11,7 @@ import textwrap
 
 from experiments.batches.stored import stored_profiles
 from experiments.bench.names import ON_REQUEST, SECTION_HELP, SECTION_NAMES
-from experiments.cli import ladder_command, rl_command, rl_compare_command
+from experiments.cli import agent_measures_command, ladder_command, rl_command, rl_compare_command
 from experiments.cli.args import (
     Parser,
     VersionAction,
@@ -210,6 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     ladder_command.add_parser(sub)
     rl_command.add_parser(sub)
     rl_compare_command.add_parser(sub)
+    agent_measures_command.add_parsers(sub)
 
     p = sub.add_parser("render", help="an MP4 of a trial's iterations, with overlay and sound")
     p.add_argument("dir", nargs="?", help="a trial directory written by `playroom run`")

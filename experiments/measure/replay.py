@@ -17,13 +17,13 @@ If the movement repeats in "alone" but not in "test", the outcome depends on wha
 context does not hold (the other toys, the stick's angle); if it does not repeat even alone, on
 small differences of the context itself (the sensitivity of contacts).
 
-`python -m experiments.measure.replay BATCH_DIR --trials N --out FILE.csv` writes one row per
-(trial, test) and prints the medians per backend.
+`playroom replay BATCH_DIR --trials N --out FILE.csv [--figure FILE.png]` writes one row per
+(trial, test) and prints the medians and means per backend
+(experiments/cli/agent_measures_command.py).
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +33,7 @@ from experiments import manifest, storage
 from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
 from experiments.measure.evaluation import EvaluationSettings, goal_trajectory, placements
 from experiments.run.trial_checks import load_trial
+from experiments.run.trial_files import TrialError
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom
@@ -94,25 +95,27 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
         dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / EVAL_FILE).exists())
         for trial_dir in dirs[:n_trials]:
             config, agent, room, _ = load_trial(trial_dir)
-            table = replay_table(agent, room, EvaluationSettings())
-            # The random command the evaluation played on each of these scenes, beside them.
             summary = storage.read_json(trial_dir / EVAL_FILE)
+            # The evaluation's scenes (its placements), and the random command it played on
+            # each of them beside the replays.
+            table = replay_table(agent, room, EvaluationSettings(int(summary["n_placements"])))
+            if table.empty:  # no arm test chosen by a model (an untrained agent)
+                continue
             data = manifest.read_evaluation_file(trial_dir, COMPETENCE_FILE, summary)
             evaluated = storage.read_table(trial_dir / COMPETENCE_FILE, data=data)
             random = evaluated[evaluated["ring"] == 1][["placement", "toy", "random_error"]]
             table = table.merge(random, on=["placement", "toy"], how="left")
             tables.append(table.assign(trial=trial_dir.name, grasp=grasp))
+    if not tables:
+        raise TrialError(
+            f"{batch_dir} holds no finished trial whose agent chose an arm movement in ring 1 "
+            f"(a trial folder with {EVAL_FILE}, past its random bootstrap)"
+        )
     return pd.concat(tables, ignore_index=True)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("batch", type=Path, help="a batch directory holding both backends")
-    parser.add_argument("--trials", type=int, default=8, help="finished trials per backend")
-    parser.add_argument("--out", type=Path, required=True, help="the CSV to write")
-    args = parser.parse_args()
-    table = replay_batch(args.batch, args.trials)
-    table.to_csv(args.out, index=False)
+def summaries(table: pd.DataFrame) -> tuple[str, str]:
+    """The replay table's medians and means per backend, as text."""
     columns = [
         "expected",
         "random_error",
@@ -120,9 +123,5 @@ def main() -> None:
         "toy_shift",
         *(f"{k}_{s}" for k in ("repeat", "error") for s in SCENES),
     ]
-    print(table.groupby("grasp")[columns].median().round(3).to_string())
-    print(table.groupby("grasp")[columns].mean().round(3).to_string())
-
-
-if __name__ == "__main__":
-    main()
+    by_grasp = table.groupby("grasp")[columns]
+    return by_grasp.median().round(3).to_string(), by_grasp.mean().round(3).to_string()

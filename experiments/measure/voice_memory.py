@@ -15,12 +15,12 @@ their commands that the caregiver recognises as that toy's name, as another word
 word (the voice's own recognition, the caregiver's rule), and the share of rows whose toy
 moved less than 2 cm from the first sample to the last (a nudge, not a bring).
 
-`python -m experiments.measure.voice_memory TRIAL_DIR [TRIAL_DIR ...] --out FILE.csv`.
+`playroom voice-memory TRIAL_DIR [TRIAL_DIR ...] --out FILE.csv`
+(experiments/cli/agent_measures_command.py).
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import numpy as np
@@ -63,22 +63,13 @@ def toy_model_rows(agent: Agent, room: Playroom) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("trials", nargs="+", type=Path, help="trial directories")
-    parser.add_argument("--out", type=Path, required=True, help="the CSV to write")
-    args = parser.parse_args()
+def trials_table(trial_dirs: list[Path]) -> pd.DataFrame:
+    """`toy_model_rows` of each trial's final agent, labelled with its trial and grasp;
+    TrialError (experiments/run/trial_files.py) for a directory that holds no readable
+    trial."""
     tables = []
-    for trial_dir in args.trials:
+    for trial_dir in trial_dirs:
         config, agent, room, _ = load_trial(trial_dir)
         table = toy_model_rows(agent, room)
         tables.append(table.assign(trial=trial_dir.name, grasp=config["trial"]["grasp"]))
-    table = pd.concat(tables, ignore_index=True)
-    table.to_csv(args.out, index=False)
-    columns = ["rows", "name", "other_word", "no_word", "nudged"]
-    print(table.groupby("grasp")[columns].mean().round(3).to_string())
-    print(table.groupby("grasp")["trial"].nunique().to_string())
-
-
-if __name__ == "__main__":
-    main()
+    return pd.concat(tables, ignore_index=True)

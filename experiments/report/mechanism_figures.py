@@ -165,7 +165,7 @@ def mechanism_figures(results: BatchResults, geometry: Geometry) -> list[FigureF
 
 
 def replay_figure(table: pd.DataFrame) -> Figure:
-    """Of `python -m experiments.measure.replay`'s table: per backend, the mean error the
+    """Of `playroom replay`'s table: per backend, the mean error the
     remembered movement leaves in each scene, from where it was learned to the test's own,
     against the random command on the test's scene; and the error the goal toy's shift adds
     (test minus stick_at_start), by how far the toy lies from where it was remembered."""
@@ -195,19 +195,3 @@ def replay_figure(table: pd.DataFrame) -> Figure:
     shift.axhline(0, color="black", linewidth=0.8)
     shift.legend(fontsize=8)
     return fig
-
-
-def main() -> None:
-    """`python -m experiments.report.mechanism_figures REPLAY.csv --out FIGURE.png`."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description="the replay test's figure (docs/comparison.md)")
-    parser.add_argument("table", help="the CSV of `python -m experiments.measure.replay`")
-    parser.add_argument("--out", required=True, help="the PNG to write")
-    args = parser.parse_args()
-    with open(args.out, "wb") as file:
-        file.write(png_bytes(replay_figure(pd.read_csv(args.table))))
-
-
-if __name__ == "__main__":
-    main()
