@@ -67,7 +67,7 @@ class BaselineSettings:
             if high is not None and value > high:
                 raise BaselineError(f"{name} must be at most {high}, got {value!r}")
         # Here, not at the module's top: the command line's parser reads this module's numbers
-        # and must load no simulator (experiments/cli/commands.py).
+        # and must load no simulator (experiments/cli/main.py).
         from experiments.run.trial_files import TrialError
 
         try:

@@ -1,13 +1,17 @@
-"""Argument types and errors of the `playroom` command line (experiments/cli/main.py)."""
+"""Argument types, shared options, errors and printed numbers of the `playroom` command line
+(experiments/cli/main.py)."""
 
 from __future__ import annotations
 
 import argparse
 from typing import Any, NoReturn
 
+import numpy as np
+
+from experiments.cli.overrides import dotted_setting
 from learner.config import LearnerConfig
 from models.presets import DEFAULT_PRESET
-from models.tracts import DEFAULT_TRACT
+from models.tracts import DEFAULT_TRACT, TRACTS
 from sim.config import DEFAULT_WORLD
 from sim.grasping.names import DEFAULT_GRASP
 
@@ -122,4 +126,32 @@ def study_reference_option(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="processes playing the study's random reference when it is not kept yet "
         "(default: cores; the numbers do not depend on it)",
+    )
+
+
+def percent(fraction: float | None) -> str:
+    """Competence as the report pages print it (experiments/report/pages.pct, one decimal):
+    "-0.8%", "46.0%", "n/a" (also for None: eval.json's null for a number that is not finite).
+    Kept here so that the CLI's summaries load no report code."""
+    return "n/a" if fraction is None or not np.isfinite(fraction) else f"{100 * fraction:.1f}%"
+
+
+def set_option(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument(
+        "--set",
+        type=dotted_setting,
+        action="append",
+        metavar="SECTION.NAME=VALUE",
+        help="change one setting of the world or learner (repeatable; VALUE read as JSON, else "
+        f"a string), e.g. --set learner.exploration_sigma=0.05; {what}",
+    )
+
+
+def voice_option(p: argparse.ArgumentParser, which: str, default: str | None = None) -> None:
+    p.add_argument(
+        "--voice",
+        choices=TRACTS,
+        default=default,
+        help="the vocal tract: VocalTractLab (vtl) or the study's DIVA map (diva; its data "
+        f"installed once with `playroom voice-data diva PATH`); {which}",
     )

@@ -18,7 +18,7 @@ def _rung(text: str):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "ladder",
         help="rungs from one world to another, each step paired by seed",

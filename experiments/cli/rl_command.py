@@ -34,7 +34,7 @@ DESCRIPTION = (
 )
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "rl-baseline",
         help="SAC + HER on the toy goals, tested as a trial's final agent (needs the rl extra)",
@@ -125,7 +125,7 @@ def cmd_rl_baseline(args: argparse.Namespace) -> None:
 
 def _single(args: argparse.Namespace, settings: BaselineSettings, command: str) -> None:
     from experiments.baseline.run import run_baseline
-    from experiments.cli.commands import percent
+    from experiments.cli.args import percent
 
     summary = run_baseline(
         args.out,

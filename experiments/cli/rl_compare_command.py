@@ -10,7 +10,7 @@ import shlex
 from experiments.cli.args import UsageError, study_reference_option
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "rl-compare",
         help="Model Babbling against SAC + HER on the same test, paired by seed",
@@ -32,7 +32,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def cmd_rl_compare(args: argparse.Namespace) -> None:
     """The page (experiments/report/rl_page.py), printed and written."""
     from experiments.analysis.results import ReportError
-    from experiments.cli.commands import study_reference
+    from experiments.cli.report_commands import study_reference
     from experiments.report.rl_page import write_rl_compare
 
     command = shlex.join(["playroom", "rl-compare", args.model_babbling, args.sac_her])

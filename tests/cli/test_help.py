@@ -12,6 +12,7 @@ import pytest
 
 from experiments.cli.main import build_parser, main
 from experiments.cli.overrides import dotted_setting, merged
+from sim.grasping.names import GRASPS
 
 
 def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -33,10 +34,10 @@ def test_every_option_of_every_command_has_help():
 @pytest.mark.parametrize(
     "command, shown",
     [
-        ("run", ["default: 80000", "default: kinematic", "{kinematic,physical}", "--set"]),
+        ("run", ["default: 80000", "default: kinematic", "{" + ",".join(GRASPS) + "}", "--set"]),
         ("random", ["(default: 20)", "(default: kinematic)", "(default: 0)"]),
         ("render", ["(default: 640x480)", "(default: 50.0)", "(default: top)"]),
-        ("eval", ["(default: 100)", "{own,kinematic,physical}", "(default: own)"]),
+        ("eval", ["(default: 100)", "{own," + ",".join(GRASPS) + "}", "(default: own)"]),
         ("batch", ["smoke", "paper", "dashboard", "--set"]),
         ("bench", ["trial, learner, world, tracking, voice, render, emulated"]),
         ("say", ["{oey,uye,iuo,eyu,eou,yeo}"]),

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from experiments import storage
-from experiments.cli.commands import study_reference
+from experiments.cli.report_commands import study_reference
 from experiments.file_names import BATCH_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference

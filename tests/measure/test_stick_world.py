@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from experiments.cli.commands import study_reference
+from experiments.cli.report_commands import study_reference
 from experiments.measure.stick import batch_worlds, grasp_rates
 from experiments.run.settings import TrialSettings, full_config
 from experiments.storage import write_json

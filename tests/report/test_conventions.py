@@ -92,7 +92,7 @@ def test_a_paper_number_without_its_run_count_is_refused(tmp_path):
 
 @pytest.mark.parametrize("fraction", [0.46, -0.008, 0.0, 1.0, float("nan")])
 def test_the_cli_prints_competence_as_the_pages_do(fraction):
-    from experiments.cli.commands import percent
+    from experiments.cli.args import percent
     from experiments.report.pages import pct
 
     assert percent(fraction) == pct(fraction, 1)

@@ -1,0 +1,68 @@
+"""`playroom batch`: many trials on a Dask cluster, each run and evaluated."""
+
+from __future__ import annotations
+
+import argparse
+
+from experiments.batches.stored import stored_profiles
+from experiments.cli.args import (
+    UsageError,
+    percent,
+    positive_int,
+    set_option,
+)
+from experiments.cli.overrides import merged
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("batch", help="many trials on a Dask cluster, each run and evaluated")
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument(
+        "--profile",
+        choices=stored_profiles(),
+        metavar="NAME",
+        help=f"a stored profile: {', '.join(stored_profiles())} (experiments/batches/profiles/)",
+    )
+    which.add_argument("--config", help="a JSON file of the same form as the profiles")
+    p.add_argument("--out", required=True, help="the batch directory")
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="a running Dask scheduler (default: a local cluster, its dashboard on a free port)",
+    )
+    p.add_argument("--workers", type=positive_int, help="local worker processes (default: cores)")
+    set_option(p, "merged into the batch's overrides")
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress bar (the dashboard's link is still printed)",
+    )
+    p.set_defaults(func=cmd_batch)
+
+
+def cmd_batch(args: argparse.Namespace) -> None:
+    """Many trials on Dask, each run and evaluated; reruns skip what is complete."""
+    from experiments.batches.runner import run_batch
+    from experiments.batches.spec import BatchError, load_spec, with_overrides
+
+    try:
+        spec = load_spec(args.profile, args.config)
+        if args.set:
+            try:
+                spec = with_overrides(spec, merged(spec.overrides, args.set))
+            except ValueError as exc:  # a --set given twice
+                raise BatchError(str(exc)) from None
+        results = run_batch(
+            spec, args.out, scheduler=args.scheduler, n_workers=args.workers,
+            progress=not args.quiet,
+        )  # fmt: skip
+    except BatchError as exc:
+        raise UsageError(str(exc)) from None
+    for name, summary in sorted(results.items()):
+        c = summary["competence"]
+        tested = "".join(
+            f"; in the {world} world ring1 {percent(t['ring1'])}, all {percent(t['all'])}"
+            for world, t in summary.get("eval_worlds", {}).items()
+        )
+        print(f"  {name}: competence ring1 {percent(c['ring1'])}, all {percent(c['all'])}{tested}")
+    print(f"{args.out}: {len(spec.trials())} trials complete")
