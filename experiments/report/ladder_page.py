@@ -46,7 +46,7 @@ def signed_text(kind: str, x: float) -> str:
     )
 
 
-def _level(kind: str, x: float) -> str:
+def level_text(kind: str, x: float) -> str:
     return signed_text(kind, x).lstrip("+")
 
 
@@ -123,9 +123,9 @@ def steps_table(
     for h in measures:
         kind = h.measure.kind
         level = {r["rung"]: r["mean"] for r in _rows(levels, tested=ladder.OWN, key=h.key)}
-        cells = [_level(kind, level.get(order[0], math.nan))]
+        cells = [level_text(kind, level.get(order[0], math.nan))]
         cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.STEP)]
-        cells.append(_level(kind, level.get(order[-1], math.nan)))
+        cells.append(level_text(kind, level.get(order[-1], math.nan)))
         cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.WHOLE)]
         s = sums[h.key]
         inside = "within" if s["within"] else "outside"

@@ -29,6 +29,8 @@ from experiments.report.measures import registry
 
 MODEL_BABBLING, SAC_HER = "Model Babbling", "SAC + HER"
 LEARNERS = (MODEL_BABBLING, SAC_HER)
+# Each learner's columns in the tests' table: mb_mean, sac_mean, ...
+PREFIX = {MODEL_BABBLING: "mb", SAC_HER: "sac"}
 VALUE_COLUMNS = ["grasp", "learner", "seed", "key", "value"]
 # What a world is made of: a baseline must have learned in the world of its trial.
 WORLD_PARTS = ("world", "voice")
@@ -126,12 +128,11 @@ def learner_tests(values: pd.DataFrame, measures: list[Headline]) -> pd.DataFram
         for h in measures:
             row: dict = {"grasp": grasp, "key": h.key, "label": h.label, "kind": h.measure.kind}
             sides = {name: _series(values, grasp, name, h.key) for name in LEARNERS}
-            for name, prefix in ((MODEL_BABBLING, "mb"), (SAC_HER, "sac")):
-                finite = sides[name].to_numpy(dtype=float)
-                finite = finite[np.isfinite(finite)]
-                mean, low, high = mean_ci(finite)
+            for name, prefix in PREFIX.items():
+                mine = sides[name].to_numpy(dtype=float)
+                mean, low, high = mean_ci(mine)  # over its finite values
                 row |= {f"{prefix}_mean": mean, f"{prefix}_low": low, f"{prefix}_high": high}
-                row[f"{prefix}_n"] = len(finite)
+                row[f"{prefix}_n"] = int(np.isfinite(mine).sum())
             x, y = paired_arrays(sides[SAC_HER], sides[MODEL_BABBLING])
             difference, low, high, p = paired_difference(x, y)
             row |= {"difference": difference, "low": low, "high": high, "p": p}

@@ -23,7 +23,7 @@ from experiments.analysis.trial_tests import survives
 from experiments.report import rl_comparison as rl
 from experiments.report.figures import png_bytes
 from experiments.report.ladder import COMPETENCE
-from experiments.report.ladder_page import json_records, signed_text
+from experiments.report.ladder_page import json_records, level_text, signed_text
 from experiments.report.pages import machines_text, p_value, seeds_text
 
 FILES = ("rl-compare.csv", "rl-compare.json", "rl-compare.png", "rl-compare.md")
@@ -36,8 +36,8 @@ def _side(kind: str, row: dict, prefix: str) -> str:
     if not math.isfinite(mean):
         return f"n/a ({n})"
     low, high = row[f"{prefix}_low"], row[f"{prefix}_high"]
-    interval = f" [{signed_text(kind, low).lstrip('+')}, {signed_text(kind, high).lstrip('+')}]"
-    return f"{signed_text(kind, mean).lstrip('+')}{interval if math.isfinite(low) else ''} ({n})"
+    interval = f" [{level_text(kind, low)}, {level_text(kind, high)}]"
+    return f"{level_text(kind, mean)}{interval if math.isfinite(low) else ''} ({n})"
 
 
 def _difference(row: dict) -> str:
@@ -61,7 +61,7 @@ def _settings_lines(mb: BatchResults, sac: BatchResults, grasps: list[str]) -> l
         "|---|---|---|---|---|---|",
     ]
     for grasp in grasps:
-        for learner, results in ((rl.MODEL_BABBLING, mb), (rl.SAC_HER, sac)):
+        for learner, results in zip(rl.LEARNERS, (mb, sac), strict=True):
             mine = results.select(grasp)
             seeds = sorted(int(s) for s in mine.trials["seed"])
             movements = sorted({int(m) for m in mine.trials["iterations"]})
@@ -175,7 +175,7 @@ def figure(values: pd.DataFrame, tests: pd.DataFrame) -> Figure:
                 x = i + offset + rng.uniform(-0.05, 0.05, len(mine))
                 ax.scatter(x, 100 * mine, s=8, color=COLOURS[learner], alpha=0.6, lw=0)
                 (row,) = tests[(tests["grasp"] == grasp) & (tests["key"] == key)].to_dict("records")
-                prefix = "mb" if learner == rl.MODEL_BABBLING else "sac"
+                prefix = rl.PREFIX[learner]
                 mean, low, high = (row[f"{prefix}_{k}"] for k in ("mean", "low", "high"))
                 if math.isfinite(low):
                     err = 100 * np.array([[mean - low], [high - mean]])
