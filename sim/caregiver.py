@@ -1,13 +1,13 @@
 """The caregiver (docs/protocol.md §6): where she stands, the words she uses, what she says
 after an arm movement, what she hears of the agent's voice, and how she brings a toy.
 
-Every rule of hers is written here once, whichever path computes a movement (sim/movement.py):
+Every rule of hers is written here once, whichever backend computes a movement (sim/movement.py):
 what she says (`speak`), what she hears (`hear`), where she brings a toy (`target`) and how fast
-(`brought_path`, the positions of the whole way, which every path reads step by step).
+(`brought_path`, the positions of the whole way, which the backends follow).
 
 The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
-which word names which toy is hers, drawn once per room. How a toy she brings is moved along her
-path is the grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy,
+which word names which toy is hers, drawn once per room. How a toy she brings follows her path
+is the grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy,
 lifted above the table, in the physical backend; placed directly, as in the study, in the
 kinematic one.
 """
@@ -21,7 +21,8 @@ import numpy as np
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
 from sim.config import WorldConfig
-from sim.grasping.base import GraspBackend, Holds
+from sim.grasping.base import GraspBackend
+from sim.movement import Brought, Holds
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import VoiceConfig
 from sim.vocal.voice import Voice
@@ -124,11 +125,12 @@ class Caregiver:
         start = self.backend.caregiver_takes(physics, toy)
         self.path = brought_path(start, self.target(physics), self.config.caregiver_bring_rate)
 
-    def before_step(self, physics: PlayroomPhysics, step: int) -> None:
-        """Control step `step` (1-based): the toy she brings to its place on her path."""
-        if self.path is None or self.bringing is None:
-            return
-        self.backend.caregiver_carries(physics, self.bringing, self.path[step - 1])
+    @property
+    def brought(self) -> Brought | None:
+        """The toy she brings during this movement and her path, or None."""
+        if self.bringing is None or self.path is None:
+            return None
+        return Brought(self.bringing, self.path)
 
     def stop(self, physics: PlayroomPhysics) -> None:
         """Put the toy down where it is."""

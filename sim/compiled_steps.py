@@ -3,7 +3,8 @@
 Why: a physical iteration is 500 MuJoCo steps in 50 control steps, and each control step cost
 4-7 us of Python around MuJoCo's own work (setting the servos' targets, three calls into the
 bindings, reading the tracked positions and the contacts): up to a sixth of an arm iteration
-(`playroom bench world`, `physical_arm_iteration_compiled_over_python_steps`). Here one
+(`playroom bench world` measured the compiled loop at 0.81 of the Python one, docs/speed.md,
+before the Python loop moved to tests/stepped_oracle.py). Here one
 compiled loop runs the control steps and returns to Python only when a contact the grasp acts
 on appears (the grasp's rules stay in sim/grasping/physical.py).
 
@@ -13,10 +14,11 @@ and the caregiver's hand as the physical backend writes them (each operation rou
 own, no fast-math), and reads positions and contact sensors from the same arrays. The sensors
 are off during a control step's first substeps (`disable_flags_view`): they feed nothing back
 into the dynamics, and are read only after the last.
-tests/sim/test_compiled_steps.py holds it to the step-by-step Python loop bit for bit.
+tests/sim/test_compiled_steps.py holds it to the step-by-step Python loop (tests/sim/
+stepped_oracle.py) bit for bit.
 
 MuJoCo's library is the one its Python package ships (found beside `mujoco/__init__.py`); where
-it is not found, `AVAILABLE` is False and the room steps in Python.
+it is not found, `AVAILABLE` is False and a physical room cannot be built (`MISSING`).
 """
 
 from __future__ import annotations
@@ -46,6 +48,11 @@ def _mujoco_library() -> str | None:
 
 LIBRARY = _mujoco_library()
 AVAILABLE = LIBRARY is not None
+MISSING = (
+    "the physical backend steps MuJoCo from compiled code and needs MuJoCo's shared library "
+    f"beside the mujoco package ({os.path.dirname(mujoco.__file__)}): none was found there; "
+    "reinstall mujoco from its wheel (pip install --force-reinstall mujoco)"
+)
 if AVAILABLE:
     # The symbols the compiled code links to (numba's cache stores the calls by name).
     binding.load_library_permanently(LIBRARY)
@@ -115,6 +122,10 @@ def control_steps(
     warnings: np.ndarray,
     timestep: float,
     computed: np.ndarray,
+    qpos: np.ndarray,
+    mocap_pos: np.ndarray,
+    qpos_trace: np.ndarray,
+    mocap_trace: np.ndarray,
 ) -> int:  # pragma: no cover - compiled; tested against the Python loop
     """Control steps `start`, `start` + 1, ... of a movement, each `substeps` MuJoCo steps.
 
@@ -137,8 +148,13 @@ def control_steps(
     advances as MuJoCo's additions would advance it and their positions are the last ones.
     warnings: MuJoCo's warning counts (mjData.warning's `number`). computed[0] grows by one per
     control step computed.
+
+    qpos (nq,), mocap_pos (nmocap * 3,): the data's, flat. Where qpos_trace (n + 1, nq) and
+    mocap_trace (n + 1, nmocap * 3) have rows (a movement's trace, sim/movement.py), row k + 1
+    takes them after step k; with (0, ...) nothing is traced.
     """
     n = positions.shape[0] - 1
+    tracing = qpos_trace.shape[0] > 0
     switch = disable_flags.shape[0] > 0
     flags = disable_flags[0] if switch else 0
     n_sites = site_indices.shape[0]
@@ -169,6 +185,9 @@ def control_steps(
             positions[k + 1, i] = site_xpos[site_indices[i]]
         for i in range(body_indices.shape[0]):
             positions[k + 1, n_sites + i] = xpos[body_indices[i]]
+        if tracing:
+            qpos_trace[k + 1] = qpos
+            mocap_trace[k + 1] = mocap_pos
         for address in watched:
             if sensordata[address] > 0:
                 return k
@@ -176,6 +195,10 @@ def control_steps(
             mj_getState(model, data, after.ctypes.data, DYNAMIC_STATE)
             if warnings.sum() == warned and _same_bits(before, after):
                 _rest_until(model, data, n - 1 - k, substeps, timestep, positions, k + 1)
+                if tracing:
+                    for row in range(k + 2, n + 1):
+                        qpos_trace[row] = qpos_trace[k + 1]
+                        mocap_trace[row] = mocap_trace[k + 1]
                 return n
             before, after = after, before
     return n

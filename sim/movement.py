@@ -1,36 +1,126 @@
-"""One movement of the room (50 control steps of an arm or a vocal trajectory): the paths that
-compute it, and the one outcome each returns.
+"""One movement of the room (50 control steps of an arm or a vocal trajectory): what it did
+(`MovementOutcome`) and, when asked, where everything was after each of its steps
+(`MovementTrace`).
 
-A movement is computed
-- in closed form, whole (`closed_form_movement`), where the backend's rules are geometry (the
-  kinematic one, `sim.grasping.base.ClosedForm`) and no one watches the steps;
-- step by step through the dm_control task (`stepped_movement`): observed, through the
-  dm_control Environment, when someone watches each step (videos); unobserved, in compiled code
-  where the backend has compiled stepping (the physical one; `PlayroomTask.run_steps`).
-
-Each path returns a `MovementOutcome`. Everything around a movement that does not depend on the
-path (the caregiver hearing the agent before it; after it, which objects moved and by what, her
-word, her putting a toy down, the backend's release) is done once, by `Playroom` (sim/playroom.py):
-a rule of the caregiver's (sim/caregiver.py) or the experimenter's is written once, whatever the
-path. tests/sim/test_kinematic_paths.py holds the closed form to the stepped path, bit for bit.
+Each grasp backend computes a movement one way (`GraspBackend.simulate`: the kinematic rules
+in closed form, the physical steps in compiled code) and returns a `MovementOutcome`; everything
+around it that does not depend on the backend (the caregiver hearing the agent before it;
+after it, which objects moved and by what, her word, her putting a toy down) is done once, by
+`Playroom` (sim/playroom.py). Videos, the viewer and Gymnasium's frames draw from the trace
+after the movement (`posed`): nothing watches inside the stepping. The step-by-step Python
+forms of the rules live in tests/sim/stepped_oracle.py, the oracle the backends are held to.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple, TypeVar
 
+import mujoco
 import numpy as np
 
-from models.layout import N_STEPS, TRACKED_OBJECTS
+from models.layout import N_STEPS
 from sim import events as ev
-from sim.caregiver import Caregiver
-from sim.dm_control_import import control
-from sim.grasping.base import ClosedForm, Holds
-from sim.physics import PlayroomPhysics
-from sim.task import ARM, MovementStepper, PlayroomTask
 
-_NOTHING_HELD = Holds(None, None)
+if TYPE_CHECKING:
+    from sim.dm_control_import import dm_mujoco
+
+# The room's physics (sim/physics.py, which itself reads this module's trace).
+PhysicsT = TypeVar("PhysicsT", bound="dm_mujoco.Physics")
+
+
+ARM = "arm"
+VOICE = "voice"
+
+
+class Holds(NamedTuple):
+    """What the hand holds ("stick", "toy1", ... or None) and which toy the stick's tip holds
+    (0-based, or None)."""
+
+    hand: str | None
+    stick: int | None
+
+
+NOTHING_HELD = Holds(None, None)
+
+
+class Brought(NamedTuple):
+    """The toy the caregiver brings during a movement (0-based) and where it is to be after
+    each control step, (N_STEPS, 2): her path (sim/caregiver.py)."""
+
+    toy: int
+    path: np.ndarray
+
+
+class Movement(NamedTuple):
+    """A movement as the room asks a backend for it.
+
+    space: "arm" or "voice". controls: (N_STEPS, 3) joint targets (rad, relative to rest) of an
+    arm movement (a vocal one's are not read). start: (5, 2) the tracked positions before it.
+    sound: (N_STEPS, 2) the sound sensor's values, the outcome's. brought: the toy the caregiver
+    brings during it and her path, or None.
+    """
+
+    space: str
+    controls: np.ndarray
+    start: np.ndarray
+    sound: np.ndarray
+    brought: Brought | None
+
+
+@dataclass
+class MovementTrace:
+    """Where everything was during a movement: what a frame of it needs.
+
+    qpos: (N_STEPS + 1, nq) MuJoCo's joint positions (the arm's joints, the objects' x, y and
+    yaw), row 0 before the movement, row k after control step k. mocap_pos: (N_STEPS + 1,
+    nmocap, 3) the mocap bodies (the caregiver and her hand), rows as qpos's.
+    """
+
+    qpos: np.ndarray
+    mocap_pos: np.ndarray
+
+    @classmethod
+    def starting_at(cls, data: mujoco.MjData) -> MovementTrace:
+        """A trace whose every row is the room as `data` holds it now (the backends overwrite
+        the rows of the steps)."""
+        qpos = np.empty((N_STEPS + 1, *data.qpos.shape))
+        qpos[:] = data.qpos
+        mocap = np.empty((N_STEPS + 1, *data.mocap_pos.shape))
+        mocap[:] = data.mocap_pos
+        return cls(qpos, mocap)
+
+    def record(self, step: int, data: mujoco.MjData) -> None:
+        """Row `step` from the room as `data` holds it now."""
+        self.qpos[step] = data.qpos
+        self.mocap_pos[step] = data.mocap_pos
+
+    def replayed(self, physics: PhysicsT) -> Iterator[tuple[int, PhysicsT]]:
+        """(step, a copy of `physics` posed after that control step) for steps 1..N_STEPS: the
+        copy shares the model and has its own data, so the room itself is never computed on.
+        Its measurements (hand_position, contacts, ...) are the room's at that step, but for
+        what the backend's holds change in the model (welds, a held object's collisions), which
+        are gone once the movement ended."""
+        copy = physics.copy(share_model=True)
+        data = copy.data.ptr
+        for step in range(1, len(self.qpos)):
+            posed(copy.model.ptr, data, self, step)
+            yield step, copy
+
+
+def posed(
+    model: mujoco.MjModel, data: mujoco.MjData, trace: MovementTrace, step: int
+) -> mujoco.MjData:
+    """`data` (a scratch MjData of `model`, never the room's own) put where the room was after
+    control step `step` of `trace`, every derived quantity computed (mj_forward): what a frame,
+    a viewer or a contact list of that step reads. The mocap bodies' orientations are left as
+    `data` holds them (no movement turns one)."""
+    data.qpos[:] = trace.qpos[step]
+    data.qvel[:] = 0.0
+    data.mocap_pos[:] = trace.mocap_pos[step]
+    mujoco.mj_forward(model, data)
+    return data
 
 
 @dataclass
@@ -50,84 +140,3 @@ class MovementOutcome:
     holds: Holds
     still: bool = False
     diverged_from: np.ndarray | None = None
-
-
-def closed_form_movement(
-    closed: ClosedForm,
-    physics: PlayroomPhysics,
-    caregiver: Caregiver,
-    movement: str,
-    controls: np.ndarray,
-    start: np.ndarray,
-    sound: np.ndarray,
-) -> MovementOutcome:
-    """A whole movement from the backend's closed form; MuJoCo's state is set once, at the end.
-
-    controls: (N_STEPS, 3) joint targets of an arm movement (a vocal one's are not read).
-    start: (5, 2) the tracked positions before it; sound: (N_STEPS, 2) the sensor's values.
-    The caregiver has heard the agent already: a toy she brings follows her path.
-    """
-    positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
-    positions[0] = start
-    poses = physics.object_poses()
-    events: list[ev.Event] = []
-    holds = _NOTHING_HELD
-    still = False
-    if movement == ARM:
-        # (3, N_STEPS), C-ordered as the compiled rules were compiled for (no copy: the
-        # targets were made so, then transposed)
-        arm = closed.arm_movement(np.ascontiguousarray(controls.T), poses[0], poses[1:, :2])
-        positions[1:], events, holds = arm.positions, arm.events, arm.holds
-        poses[0] = arm.stick_pose
-    else:
-        positions[1:] = positions[0]
-        if closed.voice_grasp(positions[0, 0], poses[0]):  # the study's rule
-            events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
-            positions[1:, 1] = positions[0, 0]
-            poses[0] = (*positions[0, 0], closed.config.arm_rest_offset)
-            holds = Holds("stick", None)
-        else:
-            still = caregiver.bringing is None
-        if caregiver.bringing is not None and caregiver.path is not None:
-            positions[1:, 2 + caregiver.bringing] = caregiver.path
-    poses[1:, :2] = positions[-1, 2:]
-    physics.set_object_poses(poses)
-    return MovementOutcome(positions, sound, events, holds, still)
-
-
-def stepped_movement(
-    physics: PlayroomPhysics,
-    task: PlayroomTask,
-    env: MovementStepper,
-    observers: list[Callable[[int, dict], None]],
-    actions: np.ndarray,
-    start: np.ndarray,
-    saved: np.ndarray,
-) -> MovementOutcome:
-    """The movement `task.begin_movement` began, one control step at a time: through the
-    dm_control environment while `observers` watch (each called with (step, observation)),
-    else `task.run_steps`. actions: (N_STEPS, 10) joint targets and articulators. start: (5, 2)
-    the tracked positions before it; saved: MuJoCo's state before it, which a divergence puts
-    back."""
-    positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
-    sound = np.zeros((N_STEPS, 2))
-    positions[0] = start
-    events: list[ev.Event] = []
-    warnings = physics.warning_counts()
-    try:
-        if observers:
-            for k in range(N_STEPS):
-                obs = env.step(actions[k]).observation
-                positions[k + 1] = (obs["hand"], obs["stick_handle"], *obs["toys"])
-                sound[k] = obs["sound"]
-                for observer in observers:
-                    observer(k + 1, obs)
-                events += task.step_events
-        else:  # the same steps, reading only what the feedback needs
-            events += task.run_steps(physics, actions, positions, sound)
-        if (physics.warning_counts() > warnings).any() or not np.isfinite(positions).all():
-            raise control.PhysicsError("MuJoCo warned of an invalid state")
-    except control.PhysicsError:
-        positions[1:] = positions[0]  # the room goes on from where it was
-        return MovementOutcome(positions, sound, [], _NOTHING_HELD, diverged_from=saved)
-    return MovementOutcome(positions, sound, events, task.grasp.holds)

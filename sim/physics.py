@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -11,6 +12,9 @@ from models import playroom_xml
 from models.layout import TOYS
 from sim.config import DEFAULT_WORLD, UNPUSHED_DAMPING_FACTOR, WorldConfig
 from sim.dm_control_import import dm_mujoco
+
+if TYPE_CHECKING:
+    from sim.movement import MovementTrace
 
 ARM_JOINTS = ("shoulder", "elbow", "wrist")
 OBJECTS = ("stick", *TOYS)  # the bodies that move in the plane with joints x, y, yaw
@@ -26,6 +30,10 @@ GRASP_CONTACTS = (
 )
 # The caregiver's path when she brings nothing (PlayroomPhysics.control_steps).
 _NOT_BROUGHT = np.empty((0, 2))
+# A movement not traced: the compiled steps' trace arguments with no rows.
+_NOT_TRACED_QPOS = np.empty((0, 0))
+_NOT_TRACED_MOCAP = np.empty((0, 0))
+INTEGRATION_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 
 
 class PlayroomPhysics(dm_mujoco.Physics):
@@ -260,6 +268,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         brought: np.ndarray | None,
         positions: np.ndarray,
         watched: np.ndarray,
+        trace: MovementTrace | None = None,
     ) -> int:
         """Control steps `start`, `start` + 1, ... of a movement in compiled code, each
         CONTROL_SUBSTEPS physics steps taken as `advance` takes them: before each, the servos'
@@ -269,7 +278,8 @@ class PlayroomPhysics(dm_mujoco.Physics):
         sensor of GRASP_CONTACTS at the indices `watched` is positive, or n. With no targets
         and nothing brought, the steps after one that leaves the room's state as it found it
         (all at rest) are not computed: only the time moves (sim.compiled_steps). Only where
-        sim.compiled_steps.AVAILABLE."""
+        sim.compiled_steps.AVAILABLE. Where `trace` is given, its rows k + 1 take the joints' and
+        the mocap bodies' positions after each step k."""
         from sim.compiled_steps import DYNAMIC_STATE, control_steps, disable_flags_view
 
         if not positions.flags.c_contiguous:  # its rows are written through a flat view
@@ -301,7 +311,27 @@ class PlayroomPhysics(dm_mujoco.Physics):
             self._warning_numbers,
             self._mj_model.opt.timestep,
             self.control_steps_computed,
+            d.qpos,
+            self._mocap_pos_flat,
+            _NOT_TRACED_QPOS if trace is None else trace.qpos,
+            _NOT_TRACED_MOCAP
+            if trace is None
+            else trace.mocap_pos.reshape(len(trace.mocap_pos), -1),
         )
+
+    def integration_state(self) -> np.ndarray:
+        """MuJoCo's integration state (mjSTATE_INTEGRATION): what reproduces the room's next
+        step, and what a checkpoint keeps."""
+        m, d = self._mj_model, self._mj_data
+        state = np.empty(mujoco.mj_stateSize(m, INTEGRATION_STATE))
+        mujoco.mj_getState(m, d, state, INTEGRATION_STATE)
+        return state
+
+    def restore_integration_state(self, state: np.ndarray) -> None:
+        """Put back an `integration_state`, everything derived from it computed."""
+        m, d = self._mj_model, self._mj_data
+        mujoco.mj_setState(m, d, state, INTEGRATION_STATE)
+        mujoco.mj_forward(m, d)
 
     def warning_counts(self) -> np.ndarray:
         """(mjNWARNING,) how often MuJoCo has warned of each kind (a diverging state warns)."""

@@ -2,16 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import cast
-
 import mujoco
 import numpy as np
 
 from models.layout import (
     ARM_DIM,
-    N_ARTICULATORS,
-    N_JOINTS,
     N_STEPS,
     TOYS,
     VOICE_DIM,
@@ -25,19 +20,17 @@ from sim.commands import checked_array, checked_command
 from sim.config import WorldConfig, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
-from sim.grasping.base import ClosedForm
 from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import load as backend_class
 from sim.model_edits import ModelEdits
-from sim.movement import MovementOutcome, closed_form_movement, stepped_movement
-from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
+from sim.movement import ARM, VOICE, Movement, MovementOutcome, MovementTrace
+from sim.physics import PlayroomPhysics
 from sim.sensory import SAMPLE_STEPS, sensory_from
-from sim.task import ARM, VOICE, MovementStepper, PlayroomTask
+from sim.task import PlayroomTask
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 from sim.vocal.registry import make_tract
 
 _SOUND = block_slice("sound")  # where her word goes in s
-_PHYSICS_STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # what get_state keeps of MuJoCo
 
 
 class Playroom:
@@ -52,10 +45,11 @@ class Playroom:
     exact_voice: formants through VocalTractLab's area function and the tube model (about 5 ms
     a frame) instead of the fitted formant map (microseconds); for audio checks.
 
-    `task` and `physics` are the dm_control Task and Physics; `env` is the room's internal
-    stepping (sim.task.MovementStepper), which acts only inside a movement `act` began and is
-    never reset after the room is built. A room has no episodes: environments with `reset`,
-    one command a step, are in sim/envs/.
+    `task` and `physics` are the dm_control Task and Physics. Each movement is computed whole
+    by the backend (`GraspBackend.simulate`); with `tracing` on, `last_trace` is where
+    everything was after each of its control steps (sim/movement.py), from which videos, the
+    viewer and Gymnasium's frames are drawn. A room has no episodes: environments with
+    `reset`, one command a step, are in sim/envs/.
     """
 
     def __init__(
@@ -77,17 +71,15 @@ class Playroom:
         self.vocal_tract = make_tract(config.voice, exact_voice, voice, config)
         self.physics: PlayroomPhysics = backend.physics_class.load(config)
         self.backend = backend(config, ModelEdits(self.physics))
-        self._has_closed_form = isinstance(self.backend, ClosedForm)  # (an ABC check: 0.3 us)
         self.caregiver = Caregiver(self.backend, config, self.vocal_tract, self.rng)
-        self.task = PlayroomTask(self.backend, self.caregiver, self.vocal_tract)
-        # Internal stepping for observed movements (videos), reset once here: see its docstring.
-        self.env = MovementStepper(self.physics, self.task, CONTROL_SUBSTEPS)
+        self.task = PlayroomTask(self.vocal_tract)
         self.experimenter = Experimenter(config, self.physics, self.backend)
-        self.env.reset()
+        with self.physics.reset_context():  # as dm_control's Environment.reset starts one
+            self.task.initialize_episode(self.physics)
         self.iteration = 0
-        # Called after every control step with (step, observation): renderers and recorders
-        # watch a movement through this without changing it.
-        self.step_observers: list[Callable[[int, dict], None]] = []
+        # Whether each movement keeps its trace (`last_trace`): videos and frames read it.
+        self.tracing = False
+        self.last_trace: MovementTrace | None = None
         self._place_for_iteration()
 
     # What the agent sees ------------------------------------------------------------------
@@ -131,11 +123,7 @@ class Playroom:
         # Unobserved, the sound is no step's input (it is not physical): only what the learner
         # and the caregiver hear, the 5 sample steps, is computed now, the other steps when the
         # feedback's `sound` is read.
-        at_samples = (
-            None
-            if self.step_observers
-            else self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
-        )
+        at_samples = self.vocal_tract.frame_formants_at(frames, SAMPLE_STEPS)
         if at_samples is not None:  # (None: the tract computes every step anyway)
             formants = np.empty((N_STEPS, 2))
             formants.fill(np.nan)  # np.full's array, without its Python wrapper
@@ -192,7 +180,7 @@ class Playroom:
             "grasp": self.grasp,
             "seed": self.seed,
             "iteration": self.iteration,
-            "physics": self._physics_state(),
+            "physics": self.physics.integration_state(),
             "rng": self.rng.bit_generator.state,
             "words": [list(self.words.names), list(self.words.distractors)],
         }
@@ -201,64 +189,27 @@ class Playroom:
         """Restore a state from `get_state` of a room with the same grasp backend."""
         if state["grasp"] != self.grasp:
             raise ValueError(f"state is of a {state['grasp']!r} room, this room is {self.grasp!r}")
-        self._restore_physics(np.asarray(state["physics"]))
+        self.physics.restore_integration_state(np.asarray(state["physics"]))
         self.iteration = int(state["iteration"])
         self.rng.bit_generator.state = state["rng"]
         names, distractors = state["words"]
         self.caregiver.words = WordAssignment(tuple(names), tuple(distractors))
 
-    def _physics_state(self) -> np.ndarray:
-        """MuJoCo's integration state (mjSTATE_INTEGRATION) of the room."""
-        m, d = self.physics.model.ptr, self.physics.data.ptr
-        state = np.empty(mujoco.mj_stateSize(m, _PHYSICS_STATE))
-        mujoco.mj_getState(m, d, state, _PHYSICS_STATE)
-        return state
-
-    def _restore_physics(self, state: np.ndarray) -> None:
-        m, d = self.physics.model.ptr, self.physics.data.ptr
-        mujoco.mj_setState(m, d, state, _PHYSICS_STATE)
-        mujoco.mj_forward(m, d)
-
-    # The movement -------------------------------------------------------------------------
-    def _closed_form(self) -> ClosedForm | None:
-        """The backend, if its rules run a whole movement at once (the kinematic one) and no
-        one watches each step (a video): the step-by-step path through the dm_control task
-        gives the same result."""
-        if self._has_closed_form and not self.step_observers:
-            return cast(ClosedForm, self.backend)
-        return None
-
     def _movement(self, movement: str, controls: np.ndarray, formants: np.ndarray) -> Feedback:
         """One movement of `controls` (N_STEPS, 3) joint targets or (N_STEPS, 7) articulators;
         formants: (N_STEPS, 2) log2 Hz of a vocal one (NaN where not computed), zeros for the
-        arm. The caregiver hears the agent, one of the paths of sim/movement.py computes the
-        movement, and `_finish` ends it, whichever path it took."""
+        arm. The caregiver hears the agent, the backend computes the movement, and `_finish`
+        ends it."""
         p = self.physics
-        closed = self._closed_form()
-        saved = None
-        if closed is None:
-            if self._has_closed_form:  # placed by kinematics alone (see above)
-                mujoco.mj_forward(p.model.ptr, p.data.ptr)
-            # Only the physics changes during the steps: what a divergence puts back.
-            saved = self._physics_state()
         start = p.tracked_positions()
         voice = movement == VOICE
-        if closed is None:
-            self.task.begin_movement(p, movement, formants if voice else None)
+        self.backend.begin(p)
         heard = self.caregiver.hear(p, formants) if voice else []
-        if closed is not None:
-            sound = self.task.normalised(formants) if voice else formants
-            outcome = closed_form_movement(
-                closed, p, self.caregiver, movement, controls, start, sound
-            )
-        else:
-            assert saved is not None  # saved above on every stepped path
-            actions = np.zeros((N_STEPS, N_JOINTS + N_ARTICULATORS))
-            columns = slice(N_JOINTS, None) if voice else slice(N_JOINTS)
-            actions[:, columns] = controls
-            outcome = stepped_movement(
-                p, self.task, self.env, self.step_observers, actions, start, saved
-            )
+        sound = self.task.normalised(formants) if voice else formants
+        asked = Movement(movement, controls, start, sound, self.caregiver.brought)
+        trace = MovementTrace.starting_at(p.data.ptr) if self.tracing else None
+        outcome = self.backend.simulate(p, asked, trace)
+        self.last_trace = trace
         return self._finish(movement, outcome, heard)
 
     def _finish(self, movement: str, outcome: MovementOutcome, heard: list[ev.Event]) -> Feedback:
@@ -267,8 +218,8 @@ class Playroom:
         movement: the room put back as it was before it)."""
         p = self.physics
         if outcome.diverged_from is not None:
-            self.task.end_movement(p)
-            self._restore_physics(outcome.diverged_from)
+            self._end_movement()
+            p.restore_integration_state(outcome.diverged_from)
             diverged = [ev.Event(ev.DIVERGED, 0)]
             return self._feedback(movement, outcome.positions, outcome.sound, diverged, None)
         events = heard + outcome.events
@@ -277,8 +228,16 @@ class Playroom:
             brought_name = None if brought is None else TOYS[brought]
             events += ev.movement_events(outcome.positions, events, brought_name)
         said = self.caregiver.speak(outcome.holds, self.rng) if movement == ARM else None
-        self.task.end_movement(p)
+        self._end_movement()
         return self._feedback(movement, outcome.positions, outcome.sound, events, said)
+
+    def _end_movement(self) -> None:
+        """Everything dropped where it is, the arm back at rest, the toy she carried put down,
+        and (where the world says so) the room left to settle."""
+        p = self.physics
+        self.backend.release(p)
+        self.caregiver.stop(p)
+        self.backend.settle(p)
 
     def _feedback(
         self,
@@ -307,13 +266,7 @@ class Playroom:
         if self.iteration % self.config.toy_replace_period == 0:
             self.experimenter.place_toys(self.rng)
         self.caregiver.place(self.physics, self.rng)
-        m, d = self.physics.model.ptr, self.physics.data.ptr
-        if self._has_closed_form:
-            # Positions are all the closed form reads: the full mj_forward (contacts,
-            # constraints, forces: 5 times the cost) runs when a stepped movement begins.
-            mujoco.mj_kinematics(m, d)
-        else:
-            mujoco.mj_forward(m, d)
+        self.backend.after_placements(self.physics)
         return events
 
     @property

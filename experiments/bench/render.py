@@ -46,8 +46,7 @@ def render_figures(
                 m = rng.uniform(-1.0, 1.0, ARM_DIM)
                 start = time.perf_counter()
                 if filmed:
-                    with recorder.watching():
-                        room.act_arm(m)
+                    recorder.film("arm", m)
                     recorder.take()
                 else:
                     room.act_arm(m)

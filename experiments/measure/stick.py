@@ -1,8 +1,9 @@
 """The stick as a tool across the backends: what pushes it, how often it can be grasped.
 
-- `push_sources`: plays a trial's first iterations (its agent and room, as `playroom run` would)
-  while watching every control step, and attributes each push of the stick (it moved while the
-  hand did not hold it) to what touched it: the hand, a toy the hand holds, a free toy.
+- `push_sources`: plays a trial's first iterations (its agent and room, as `playroom run` would),
+  looks at every control step of each movement in its trace, and attributes each push of the
+  stick (it moved while the hand did not hold it) to what touched it: the hand, a toy the hand
+  holds, a free toy.
 - `grasp_rates`: the share of random arm commands that grasp the stick from its start pose, in
   each backend asked (every registered one by default), for the very same commands: how much
   harder contact grasping is than the study's distance rule. Each backend plays in the world
@@ -26,8 +27,9 @@ from experiments.file_names import CONFIG_FILE
 from experiments.log_layout import is_trial_dir
 from experiments.run.settings import TrialSettings, full_config
 from experiments.run.trial_files import fresh_trial_parts
-from models.layout import ARM_DIM, TOYS
+from models.layout import ARM_DIM, N_STEPS, TOYS
 from models.presets import DEFAULT_PRESET
+from models.world import Feedback
 from sim import Playroom
 from sim import events as ev
 from sim.config import WorldConfig, config_from_dict, world_preset
@@ -44,34 +46,42 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
     config = full_config(TrialSettings(grasp="physical", seed=seed, stick_return=stick_return))
     agent, room = fresh_trial_parts(config)
     p = room.physics
+    room.tracing = True
     stick_geoms = set(p.stick_geoms.tolist())
     toy_geom = {int(g): TOYS[i] for i, g in enumerate(p.toy_geoms)}
-    touched: set[str] = set()
 
-    def watch(step: int, observation: dict) -> None:
-        held = room.task.grasp.hand_holds
-        if held == "stick":
-            return
-        for a, b in p.touching_pairs():
-            partner = b if a in stick_geoms else a if b in stick_geoms else None
-            if partner is None:
-                continue
-            if partner == p.hand_geom:
-                touched.add("hand")
-            elif partner in toy_geom:
-                touched.add("toy held by the hand" if toy_geom[partner] == held else "free toy")
+    def touching(feedback: Feedback) -> set[str]:
+        """What touched the stick in some step of the movement, the hand not holding it."""
+        taken = _first_step(feedback, ev.STICK_GRASPED)
+        held_toy = next((e for e in feedback.events if e.kind == ev.TOY_GRASPED), None)
+        # The toy she brings is carried above the table and touches nothing meanwhile.
+        brought = {e.obj for e in feedback.events if e.kind == ev.WORD_RECOGNISED and e.obj}
+        touched: set[str] = set()
+        assert room.last_trace is not None  # the room traces
+        for step, posed in room.last_trace.replayed(p):
+            if step >= taken:
+                break
+            held = held_toy.obj if held_toy is not None and held_toy.step <= step else None
+            for a, b in posed.touching_pairs():
+                partner = b if a in stick_geoms else a if b in stick_geoms else None
+                if partner is None:
+                    continue
+                if partner == p.hand_geom:
+                    touched.add("hand")
+                elif partner in toy_geom and toy_geom[partner] not in brought:
+                    touched.add("toy held by the hand" if toy_geom[partner] == held else "free toy")
+        return touched
 
-    room.step_observers.append(watch)
     pushes: Counter[str] = Counter()
     moved: Counter[str] = Counter()
     last_grasp = -1
     for iteration in range(iterations):
-        touched.clear()
         before = p.stick_handle()
         _, _, feedback = agent.play(room)
         if ev.STICK_GRASPED in feedback.kinds():
             last_grasp = iteration
         if any(e.kind == ev.STICK_MOVED and e.by == "push" for e in feedback.events):
+            touched = touching(feedback)
             distance = float(np.linalg.norm(feedback.positions[-1, 1] - before))
             for source in touched or {"nothing"}:
                 pushes[source] += 1
@@ -84,6 +94,11 @@ def push_sources(seed: int, iterations: int, stick_return: str = "never") -> dic
         "last_stick_grasp": last_grasp,
         "final_handle_distance": float(np.hypot(*p.stick_handle())),
     }
+
+
+def _first_step(feedback: Feedback, kind: str) -> int:
+    """The step of the movement's first event of `kind`, or one past its last step."""
+    return next((e.step for e in feedback.events if e.kind == kind), N_STEPS + 1)
 
 
 def batch_worlds(batch_dirs: Iterable[str | os.PathLike]) -> dict[str, dict]:

@@ -158,8 +158,7 @@ class EpisodeRenderer:
         for _ in range(self.lead_frames):
             recorder.capture()
         try:
-            with recorder.watching():
-                feedback = room.act(motor_space, m)
+            feedback = recorder.film(motor_space, m)
         except Exception:
             recorder.take()  # a refused or failed command leaves no frames behind
             raise

@@ -1,17 +1,17 @@
 """Offscreen frames of a room: one per control step, each with the camera view it was taken from.
 
-A `FrameRecorder` renders a room's scene with MuJoCo's offscreen renderer, on demand or, while
-attached to `Playroom.step_observers`, after every control step. Rendering uses the OpenGL
+A `FrameRecorder` renders a room's scene with MuJoCo's offscreen renderer, on demand or, for a
+movement it films, at every control step, drawn from the movement's trace (sim/movement.py)
+after the movement: the movement itself is computed as in a trial. Rendering uses the OpenGL
 backend MuJoCo loaded (`MUJOCO_GL`): this module never sets it, because mujoco reads it once at
 its first import and the `playroom` command chooses it before that (experiments/video/gl.py).
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -19,7 +19,9 @@ import numpy as np
 from experiments.video import gl
 from experiments.video.encoding import RenderError
 from experiments.video.overlay import CameraView
+from models.world import Feedback
 from sim import Playroom
+from sim.physics import PlayroomPhysics
 
 DEFAULT_SIZE = (640, 480)  # width, height (px)
 CAMERAS = ("top", "hand_view")
@@ -55,8 +57,8 @@ def _check_camera_in_model(camera: str, model: mujoco.MjModel) -> None:
 
 
 class FrameRecorder:
-    """Renders a room's scene offscreen: on demand (`capture`) and, while attached to the
-    room's `step_observers`, once after every control step.
+    """Renders a room's scene offscreen: on demand (`capture`) and at every control step of a
+    movement (`film`).
 
     size: (width, height) px; camera: a camera of the MJCF ("top" or "hand_view"); shadows:
     MuJoCo's shadow maps, off by default: on Mesa's software EGL they halve the frame rate, and
@@ -96,9 +98,11 @@ class FrameRecorder:
         self.frames: list[np.ndarray] = []
         self.views: list[CameraView] = []
 
-    def capture(self) -> np.ndarray:
-        """Render the room as it is now; append and return the frame."""
-        model, data = self.room.physics.model.ptr, self.room.physics.data.ptr
+    def capture(self, physics: PlayroomPhysics | None = None) -> np.ndarray:
+        """Render the room as it is now (or `physics`, a posed copy of it); append and return
+        the frame."""
+        physics = self.room.physics if physics is None else physics
+        model, data = physics.model.ptr, physics.data.ptr
         self._renderer.update_scene(data, camera=self.camera)
         self._renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
         frame = self._renderer.render()
@@ -106,24 +110,26 @@ class FrameRecorder:
         self.views.append(CameraView.of(model, data, self.camera, self.width, self.height))
         return frame
 
-    def __call__(self, step: int, observation: dict) -> None:
-        """The step observer: one frame per control step."""
-        self.capture()
+    def film(self, motor_space: str, m: np.ndarray) -> Feedback:
+        """`room.act(motor_space, m)`, then one frame per control step of the movement, drawn
+        from its trace; returns the feedback. A refused or failed command adds no frame."""
+        room = self.room
+        tracing = room.tracing
+        room.tracing = True
+        try:
+            feedback = room.act(motor_space, m)
+        finally:
+            room.tracing = tracing
+        assert room.last_trace is not None  # traced: act ran
+        for _, posed in room.last_trace.replayed(room.physics):
+            self.capture(posed)
+        return feedback
 
     def take(self) -> tuple[list[np.ndarray], list[CameraView]]:
         """The frames and views captured so far; the recorder starts empty again."""
         frames, views = self.frames, self.views
         self.frames, self.views = [], []
         return frames, views
-
-    @contextlib.contextmanager
-    def watching(self) -> Iterator[FrameRecorder]:
-        """Attached to the room's step observers inside the block, detached after it."""
-        self.room.step_observers.append(self)
-        try:
-            yield self
-        finally:
-            self.room.step_observers.remove(self)
 
     def close(self) -> None:
         """Release the GL context (idempotent)."""

@@ -10,9 +10,11 @@ import os
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
+import mujoco
 import numpy as np
 
 from experiments import storage
@@ -21,9 +23,11 @@ from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import fresh_trial_parts
 from models.layout import ARM_DIM, VOICE_DIM
 from models.presets import DEFAULT_PRESET
+from models.world import Feedback
 from sim import Playroom
 from sim.config import world_preset
-from sim.physics import CONTROL_SUBSTEPS
+from sim.movement import posed
+from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 
 
 class ViewError(Exception):
@@ -41,19 +45,41 @@ def display_missing() -> str | None:
     )
 
 
-def _watching(room: Playroom, viewer, pace: float) -> Callable[[int, dict], None]:
-    """A step observer that shows each control step and keeps to `pace` x real time."""
-    step_s = room.physics.model.opt.timestep * CONTROL_SUBSTEPS / pace
-    clock = {"next": time.perf_counter()}
+class _Window:
+    """MuJoCo's passive viewer of a copy of the room's physics (its own data: the room's is
+    never touched by the window's thread), showing each control step of every movement from
+    the movement's trace at `pace` x real time, and the room as it is between movements."""
 
-    def observe(step: int, observation: dict) -> None:
-        if not viewer.is_running():  # closed: the movement ends unseen, then the command
-            return
-        viewer.sync()
-        clock["next"] += step_s
-        time.sleep(max(0.0, clock["next"] - time.perf_counter()))
+    def __init__(self, room: Playroom, viewer: Any, shown: PlayroomPhysics, pace: float) -> None:
+        self.room, self.viewer, self.shown = room, viewer, shown
+        self.step_s = room.physics.model.opt.timestep * CONTROL_SUBSTEPS / pace
+        room.tracing = True
+        self._show_room()
 
-    return observe
+    def act(self, motor_space: str, m: np.ndarray) -> Feedback:
+        """The command acted in the room, its movement shown step by step."""
+        feedback = self.room.act(motor_space, m)
+        trace = self.room.last_trace
+        assert trace is not None  # the room traces
+        model, data = self.shown.model.ptr, self.shown.data.ptr
+        clock = time.perf_counter()
+        for step in range(1, len(trace.qpos)):
+            if not self.viewer.is_running():  # closed: the movement ends unseen
+                return feedback
+            with self.viewer.lock():
+                posed(model, data, trace, step)
+            self.viewer.sync()
+            clock += self.step_s
+            time.sleep(max(0.0, clock - time.perf_counter()))
+        self._show_room()
+        return feedback
+
+    def _show_room(self) -> None:
+        source, data = self.room.physics.data.ptr, self.shown.data.ptr
+        with self.viewer.lock():
+            data.qpos[:], data.mocap_pos[:] = source.qpos, source.mocap_pos
+            mujoco.mj_forward(self.shown.model.ptr, data)
+        self.viewer.sync()
 
 
 # How long to wait for the viewer's window to close after the last iteration (s).
@@ -61,19 +87,20 @@ CLOSE_WAIT_S = 10
 
 
 @contextlib.contextmanager
-def _launch(room: Playroom) -> Iterator:
-    """The passive viewer of the room, closed on leaving: its window's thread is waited for,
-    since GLFW is terminated at exit and would pull the window from under a running thread
-    (a segmentation fault at the command's end)."""
+def _launch(room: Playroom, pace: float) -> Iterator[_Window]:
+    """The passive viewer of a copy of the room, closed on leaving: its window's thread is
+    waited for, since GLFW is terminated at exit and would pull the window from under a running
+    thread (a segmentation fault at the command's end)."""
     import mujoco.viewer
 
     before = set(threading.enumerate())
+    shown = room.physics.copy(share_model=True)
     handle = mujoco.viewer.launch_passive(
-        room.physics.model.ptr, room.physics.data.ptr, show_left_ui=False, show_right_ui=False
+        shown.model.ptr, shown.data.ptr, show_left_ui=False, show_right_ui=False
     )
     window_threads = set(threading.enumerate()) - before
     try:
-        yield handle
+        yield _Window(room, handle, shown, pace)
     finally:
         handle.close()
         for thread in window_threads:
@@ -85,13 +112,12 @@ def view_random(grasp: str, seed: int, iterations: int, voice: str, pace: float 
     were shown (fewer if the window was closed)."""
     room = Playroom(grasp=grasp, seed=seed, config=world_preset(DEFAULT_PRESET, voice=voice))
     rng = np.random.default_rng([seed, 1])  # a stream apart from the room's own
-    with _launch(room) as viewer:
-        room.step_observers.append(_watching(room, viewer, pace))
+    with _launch(room, pace) as window:
         for shown in range(iterations):
-            if not viewer.is_running():
+            if not window.viewer.is_running():
                 return shown
             space = "arm" if rng.random() < 0.5 else "voice"
-            room.act(space, rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM))
+            window.act(space, rng.uniform(-1.0, 1.0, ARM_DIM if space == "arm" else VOICE_DIM))
     return iterations
 
 
@@ -109,10 +135,9 @@ def view_trial(trial_dir: str | os.PathLike, start: int, count: int, pace: float
     agent, room = fresh_trial_parts(config)
     for _ in range(start):
         agent.play(room)
-    with _launch(room) as viewer:
-        room.step_observers.append(_watching(room, viewer, pace))
+    with _launch(room, pace) as window:
         for shown in range(min(count, total - start)):
-            if not viewer.is_running():
+            if not window.viewer.is_running():
                 return shown
-            agent.play(room)
+            agent.play(room, lambda proposal: window.act(proposal.motor_space, proposal.m))
     return min(count, total - start)

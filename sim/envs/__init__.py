@@ -13,9 +13,8 @@ iterations (one step = one arm or voice command, as the study's agent acts):
 
 Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
 (sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
-episode's `Playroom` from its seed; `room.env`, the room's own dm_control Environment, is only
-its internal stepping (sim/task.py, `MovementStepper`). The classes load
-on first use, so that registering costs no MuJoCo.
+episode's `Playroom` from its seed, and draw frames from its movements' traces
+(sim/movement.py). The classes load on first use, so that registering costs no MuJoCo.
 """
 
 from __future__ import annotations

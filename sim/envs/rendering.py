@@ -23,7 +23,6 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from models.layout import N_STEPS
 from sim import GL_VARIABLE, environment_kept, gl_library_problem
 
 BACKENDS = ("egl", "osmesa", "glfw")
@@ -162,27 +161,28 @@ def _free_gl(context: Any, mjr: Any) -> None:
 
 
 class MovementEnd:
-    """Watches a room's movements from now on and keeps its pose (joint positions and mocap
-    bodies) at each one's last control step: after it the room puts the arm back to rest, drops
-    what is held and places things for the next command, so the room as it is after a step no
-    longer shows the movement. Watching makes the room step its movements one control step at a
-    time (a `Playroom` step observer: the path videos take, held to the unwatched paths bit for
-    bit by tests/sim/test_kinematic_paths.py and tests/sim/test_compiled_steps.py): the same
-    world, more slowly."""
+    """The room's pose (joint positions and mocap bodies) at the last control step of its last
+    movement, from the movement's trace (sim/movement.py): after it the room puts the arm back
+    to rest, drops what is held and places things for the next command, so the room as it is
+    after a step no longer shows the movement. From now on the room traces its movements
+    (`Playroom.tracing`: the same world, a few copies of its joints a step more)."""
 
     def __init__(self, room: Any) -> None:
         self.room = room
-        self.pose: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        room.step_observers.append(self._observe)
+        room.tracing = True
+        self._forgotten = room.last_trace
 
     def forget(self) -> None:
         """No pose kept: until the next movement ends, frames show the room as it is."""
-        self.pose = None
+        self._forgotten = self.room.last_trace
 
-    def _observe(self, step: int, observation: dict) -> None:
-        if step == N_STEPS:
-            data = self.room.physics.data.ptr
-            self.pose = (data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+    @property
+    def pose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """(qpos, mocap_pos, mocap_quat) at the last movement's end, or None."""
+        trace = self.room.last_trace
+        if trace is None or trace is self._forgotten:
+            return None
+        return trace.qpos[-1], trace.mocap_pos[-1], self.room.physics.data.ptr.mocap_quat
 
 
 def display_missing() -> str | None:

@@ -4,11 +4,11 @@
   imports none), and `load(name)`, which imports one.
 - `names`: the backends' names (the registry's keys) and the default one; no MuJoCo, so the
   command line reads them.
-- `base`: `GraspBackend`, what every backend offers the room, the task, the caregiver and the
-  experimenter, and what it declares for the trial's record (`reach`, `capabilities`);
-  `ClosedForm`, what a backend whose movements are closed-form geometry adds.
-- `kinematic`: the study's distance rules, stepped and in closed form side by side.
-- `physical`: grasping through MuJoCo contacts and welds.
+- `base`: `GraspBackend`, what every backend offers the room (one `simulate` per movement),
+  the caregiver and the experimenter, and what it declares for the trial's record (`reach`,
+  `capabilities`).
+- `kinematic`: the study's distance rules over a whole movement, in closed form.
+- `physical`: grasping through MuJoCo contacts and welds, its steps compiled.
 
 Adding a backend: a module with a `GraspBackend` subclass and one line in
 `registry.REGISTRY`; tests/sim/test_backend_contract.py runs every registered backend.

@@ -1,17 +1,15 @@
-"""The study's kinematic rules (docs/protocol.md §5, §6; the catch rule departs, §11), each
-written twice: stepped, as the dm_control task applies it one control step at a time (the
-room's path when step observers watch, as in videos), and in closed form over a whole movement
-at once (the room's fast path; the arm's rules compiled in kinematic_kernel.py). The arm
-follows its targets exactly and objects move only when held or carried, so a movement is
-geometry: the hand's path is the forward kinematics of the 50 targets, a rule fires at the
-first step at which a distance drops below its threshold, and held objects follow the hand (or
-the held stick's tip) from that step on. tests/sim/test_kinematic_paths.py compares the two
-forms on thousands of commands, sample by sample and event by event: change a rule in both
-forms, and run it.
+"""The study's kinematic rules (docs/protocol.md §5, §6; the catch rule departs, §11) over a
+whole movement at once: the arm follows its targets exactly and objects move only when held or
+carried, so a movement is geometry. The hand's path is the forward kinematics of the 50
+targets, a rule fires at the first step at which a distance drops below its threshold, and held
+objects follow the hand (or the held stick's tip) from that step on; the arm's rules run
+compiled (kinematic_kernel.py). tests/sim/stepped_oracle.py writes the same rules one control
+step at a time, as the study states them, and tests/sim/test_kinematic_paths.py holds this
+closed form to that oracle on thousands of commands, sample by sample and event by event.
 
 Under `WorldConfig.arm_dynamics` "servo" (a rung of the contact ladder) the arm is
 where the physical model's servos take it while tracking the targets (sim/arm_servo.py), not at
-the targets: both forms read its angles from the same servo steps, and the rules act on them.
+the targets: the rules act on its angles.
 """
 
 from __future__ import annotations
@@ -21,13 +19,22 @@ import functools
 import mujoco
 import numpy as np
 
-from models.layout import N_STEPS, TOYS
+from models.layout import N_STEPS, TOYS, TRACKED_OBJECTS
 from sim import events as ev
 from sim.arm_servo import ArmServo
 from sim.config import WorldConfig
-from sim.grasping.base import ArmMovement, ClosedForm, Holds, arm_to_rest
+from sim.grasping.base import ArmMovement, GraspBackend
 from sim.kinematics import hand_positions
 from sim.model_edits import ModelEdits
+from sim.movement import (
+    ARM,
+    NOTHING_HELD,
+    Brought,
+    Holds,
+    Movement,
+    MovementOutcome,
+    MovementTrace,
+)
 from sim.physics import PlayroomPhysics
 
 
@@ -70,105 +77,100 @@ class KinematicPhysics(PlayroomPhysics):
         return np.array([x, y]) + self.config.stick_length * np.array([np.cos(yaw), np.sin(yaw)])
 
 
-class KinematicGrasp(ClosedForm):
+class KinematicGrasp(GraspBackend):
     """The arm follows its targets exactly (or its servos', `arm_dynamics` "servo") and objects
     attach by distance. Held objects are placed, not simulated."""
 
     name = "kinematic"
     physics_class = KinematicPhysics
     solid = False
-    _arm_moved = False  # whether a stepped movement moved the arm from rest (`release`)
+    closed_form = True
 
     def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
         super().__init__(config, edits)
         # The servo-driven arm under arm_dynamics "servo"; None: the arm is set to its targets.
         self._servo = ArmServo() if config.arm_dynamics == "servo" else None
 
-    def begin(self, physics: PlayroomPhysics) -> None:
-        super().begin(physics)
-        if self._servo is not None:  # every movement starts from rest
-            self._servo.reset()
-
-    # Arm movements: the grasp and catch rules, stepped ------------------------------------
-    def before_step(
-        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
-    ) -> list[ev.Event]:
-        d = physics.data.ptr
-        servo = self._servo
-        d.qpos[physics.arm_qpos] = joint_targets if servo is None else servo.step(joint_targets)
-        self._arm_moved = True
-        mujoco.mj_kinematics(physics.model.ptr, d)
-        events = self._attach_by_distance(physics, step)
-        self._carry(physics)
-        return events
-
-    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
-        return []
-
-    def _attach_by_distance(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
-        """The study's rules: a free hand takes the stick, else the first toy within reach; the
-        stick's tip catches the first free toy within reach if it holds none: a held stick's
-        only (catch_rule "held_stick"), or the stick wherever it is ("study")."""
-        cfg = self.config
-        events: list[ev.Event] = []
-        positions = physics.tracked_positions()  # hand, handle, toy1-3
-        free = self._free_toy_mask()
-        if self.hand_holds is None:
-            near = np.hypot(*(positions[1:] - positions[0]).T) < cfg.grasp_distance
-            near[1:] &= free
-            if near.any():
-                first = int(np.argmax(near))
-                if first == 0:
-                    self.hand_holds = "stick"
-                    events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
-                else:
-                    self.hand_holds = TOYS[first - 1]
-                    free[first - 1] = False
-                    events.append(ev.Event(ev.TOY_GRASPED, step, obj=TOYS[first - 1], by="hand"))
-        held = self.hand_holds == "stick"
-        if (held or cfg.catch_rule == "study") and self.stick_holds is None:
-            tip = self._held_stick_tip(physics) if held else physics.stick_tip()
-            near = (np.hypot(*(positions[2:] - tip).T) < cfg.catch_distance) & free
-            if near.any():
-                self.stick_holds = int(np.argmax(near))
-                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=TOYS[self.stick_holds], by="stick"))
-        return events
-
-    def _held_stick_tip(self, physics: PlayroomPhysics) -> np.ndarray:
-        """The tip of the stick held by the hand: the handle is at the hand and the stick
-        points along the hand's orientation."""
-        yaw = physics.hand_angle()
-        return physics.hand_position() + self.config.stick_length * np.array(
-            [np.cos(yaw), np.sin(yaw)]
-        )
-
-    def _carry(self, physics: PlayroomPhysics) -> None:
-        """Place held objects: the handle at the hand, toys at the hand or the stick's tip."""
-        if self.hand_holds is None:
-            if self.stick_holds is not None:  # a toy caught by the lying stick, at its tip
-                poses = physics.object_poses()
-                poses[1 + self.stick_holds, :2] = physics.stick_tip()
-                physics.set_object_poses(poses)
-            return
-        poses = physics.object_poses()
-        if self.hand_holds == "stick":
-            poses[0] = (*physics.hand_position(), physics.hand_angle())
-            if self.stick_holds is not None:
-                poses[1 + self.stick_holds, :2] = self._held_stick_tip(physics)
-        else:
-            poses[1 + TOYS.index(self.hand_holds), :2] = physics.hand_position()
-        physics.set_object_poses(poses)
-
     def release(self, physics: PlayroomPhysics) -> None:
+        # The arm never left rest: the closed form computes the hand's path without moving it.
         self.hand_holds = None
         self.stick_holds = None
-        # Only the stepped path moves the arm (the closed form computes the hand's path without
-        # it, and no dynamics give it a velocity or a control): at rest, it stays as it is.
-        if self._arm_moved:
-            arm_to_rest(physics)
-            self._arm_moved = False
 
-    # Arm movements: the same rules in closed form -----------------------------------------
+    def after_placements(self, physics: PlayroomPhysics) -> None:
+        """Positions are all the closed form reads: the full mj_forward (contacts, constraints,
+        forces: 5 times the cost) would compute nothing it uses."""
+        mujoco.mj_kinematics(physics.model.ptr, physics.data.ptr)
+
+    # A movement, whole ----------------------------------------------------------------------
+    def simulate(
+        self, physics: PlayroomPhysics, movement: Movement, trace: MovementTrace | None
+    ) -> MovementOutcome:
+        """`GraspBackend.simulate` in closed form; MuJoCo's state is set once, at the end."""
+        positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
+        positions[0] = movement.start
+        brought = movement.brought
+        poses = physics.object_poses()
+        events: list[ev.Event] = []
+        holds = NOTHING_HELD
+        still = False
+        arm = None
+        if movement.space == ARM:
+            # (3, N_STEPS), C-ordered as the compiled rules were compiled for (no copy: the
+            # targets were made so, then transposed)
+            targets = np.ascontiguousarray(movement.controls.T)
+            arm = self.arm_movement(targets, poses[0], poses[1:, :2])
+            positions[1:], events, holds = arm.positions, arm.events, arm.holds
+        else:
+            positions[1:] = positions[0]
+            if self.voice_grasp(positions[0, 0], poses[0]):  # the study's rule
+                events.append(ev.Event(ev.STICK_GRASPED, 1, obj="stick", by="hand"))
+                positions[1:, 1] = positions[0, 0]
+                holds = Holds("stick", None)
+            else:
+                still = brought is None
+            if brought is not None:
+                positions[1:, 2 + brought.toy] = brought.path
+        if trace is not None:
+            self._trace(physics, trace, positions, events, arm, brought)
+        if arm is not None:
+            poses[0] = arm.stick_pose
+        elif holds.hand == "stick":  # taken by the resting hand, along the last segment
+            poses[0] = (*positions[0, 0], self.config.arm_rest_offset)
+        poses[1:, :2] = positions[-1, 2:]
+        physics.set_object_poses(poses)
+        self.hand_holds, self.stick_holds = holds
+        return MovementOutcome(positions, movement.sound, events, holds, still)
+
+    def _trace(
+        self,
+        physics: PlayroomPhysics,
+        trace: MovementTrace,
+        positions: np.ndarray,
+        events: list[ev.Event],
+        arm: ArmMovement | None,
+        brought: Brought | None,
+    ) -> None:
+        """Rows 1..N_STEPS of `trace` (its rows all the room before the movement) from the
+        movement's positions: the joints where the arm went, the handle and the toys where the
+        positions put them, a held stick along the last segment, as the stepped rules place
+        them (tests/sim/stepped_oracle.py)."""
+        qpos = trace.qpos[1:]
+        stick_x, stick_y, stick_yaw = physics.object_qpos[0]
+        taken = next((e.step for e in events if e.kind == ev.STICK_GRASPED), None)
+        if taken is not None:  # the handle in the hand from that step on
+            rows = slice(taken - 1, None)
+            qpos[rows, stick_x], qpos[rows, stick_y] = positions[taken:, 1].T
+            held_yaw = self.config.arm_rest_offset if arm is None else arm.last_segment[rows]
+            qpos[rows, stick_yaw] = held_yaw
+        # An arm movement's toys are where its positions say (an unmoved toy's are its own
+        # joints', copied); during a vocal one only the toy she brings moves.
+        toys = range(len(TOYS)) if arm is not None else [] if brought is None else [brought.toy]
+        for toy in toys:
+            x, y, _ = physics.object_qpos[1 + toy]
+            qpos[:, x], qpos[:, y] = positions[1:, 2 + toy].T
+        if arm is not None:
+            qpos[:, physics.arm_qpos] = arm.angles.T
+
     def arm_movement(
         self, joint_targets: np.ndarray, stick_pose: np.ndarray, toys: np.ndarray
     ) -> ArmMovement:
@@ -177,7 +179,7 @@ class KinematicGrasp(ClosedForm):
 
         config = self.config
         # The arm's joint angles after each step: its targets, or where its servos take it
-        # (the same servo steps as `before_step`'s, from rest).
+        # (`ArmServo.path`: from rest, one servo step a control step).
         angles = joint_targets if self._servo is None else self._servo.path(joint_targets)
         # sim/kinematics.hand_positions' angles, cosines and sines; the rules themselves run
         # compiled (sim/grasping/kinematic_kernel.py), with the same arithmetic.
@@ -203,6 +205,7 @@ class KinematicGrasp(ClosedForm):
             answers,
         )
         k, first, on_stick, caught_step, caught_toy = answers.tolist()
+        path = (angles, absolute[-1])
         events: list[ev.Event] = []
         if on_stick != kernel.NONE:
             events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
@@ -210,18 +213,21 @@ class KinematicGrasp(ClosedForm):
         # A toy the lying stick caught stays on it; only a free stick catches in the hand.
         on_tip = None if on_stick == kernel.NONE else on_stick
         if k == N_STEPS:
-            return ArmMovement(positions, final_stick, events, Holds(None, on_tip))
+            return ArmMovement(positions, final_stick, events, Holds(None, on_tip), *path)
         if first > 0:
             toy = TOYS[first - 1]
             events.insert(0, ev.Event(ev.TOY_GRASPED, k + 1, obj=toy, by="hand"))
-            return ArmMovement(positions, final_stick, _in_step_order(events), Holds(toy, on_tip))
+            return ArmMovement(
+                positions, final_stick, _in_step_order(events), Holds(toy, on_tip), *path
+            )
         events.append(ev.Event(ev.STICK_GRASPED, k + 1, obj="stick", by="hand"))
         final_stick = np.array([*positions[-1, 0], absolute[-1, -1]])
         if caught_toy != kernel.NONE:
             obj = TOYS[caught_toy]
             events.append(ev.Event(ev.TOY_CAUGHT, caught_step + 1, obj=obj, by="stick"))
             on_tip = caught_toy
-        return ArmMovement(positions, final_stick, _in_step_order(events), Holds("stick", on_tip))
+        holds = Holds("stick", on_tip)
+        return ArmMovement(positions, final_stick, _in_step_order(events), holds, *path)
 
     @functools.cached_property
     def _lengths(self) -> np.ndarray:
@@ -234,19 +240,7 @@ class KinematicGrasp(ClosedForm):
         cfg = self.config
         return np.array([cfg.grasp_distance, cfg.catch_distance, cfg.stick_length])
 
-    # Vocal movements: the resting hand's grab, stepped and in closed form -----------------
-    def during_voice(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
-        """With the study's catch rule, the resting hand takes a stick whose handle lies
-        within the grasp distance (the study's code checks it in vocal movements too)."""
-        if self.config.catch_rule != "study" or self.hand_holds is not None:
-            return []
-        positions = physics.tracked_positions()
-        if np.hypot(*(positions[1] - positions[0])) >= self.config.grasp_distance:
-            return []
-        self.hand_holds = "stick"
-        self._carry(physics)
-        return [ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand")]
-
+    # Vocal movements: the resting hand's grab -----------------------------------------------
     def voice_grasp(self, hand: np.ndarray, stick_pose: np.ndarray) -> bool:
         """With the study's catch rule, whether the handle lies within the grasp distance."""
         if self.config.catch_rule != "study":
@@ -258,11 +252,6 @@ class KinematicGrasp(ClosedForm):
         """Nothing to take: the toy itself is placed at every step; its path starts where it
         lies."""
         return physics.object_poses()[1 + toy, :2]
-
-    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, place: np.ndarray) -> None:
-        poses = physics.object_poses()
-        poses[1 + toy, :2] = place
-        physics.set_object_poses(poses)
 
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
         """Nothing to undo: the toy lies where it was last placed."""

@@ -15,11 +15,14 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from models.layout import TOYS
+from models.layout import N_JOINTS, N_STEPS, TOYS, TRACKED_OBJECTS
 from sim import events as ev
-from sim.config import SETTLE_PHYSICS_STEPS
+from sim.compiled_steps import AVAILABLE, MISSING
+from sim.config import SETTLE_PHYSICS_STEPS, WorldConfig
 from sim.grasping.base import GraspBackend, arm_to_rest
 from sim.kinematics import segment_distance
+from sim.model_edits import ModelEdits
+from sim.movement import ARM, NOTHING_HELD, Movement, MovementOutcome, MovementTrace
 from sim.physics import OBJECTS, PlayroomPhysics
 
 # The name under which the caregiver's carrying edits the model (sim/model_edits.py); the
@@ -32,35 +35,63 @@ TIP_ON_TOYS = slice(1 + len(TOYS), 1 + 2 * len(TOYS))
 _WATCHED_BY_EMPTY_HAND = np.arange(TIP_ON_TOYS.start)
 _WATCHED_BY_EMPTY_TIP = np.arange(TIP_ON_TOYS.start, TIP_ON_TOYS.stop)
 _WATCHED_BY_NOTHING = np.empty(0, dtype=np.int64)
+_NO_TARGETS = np.empty((0, N_JOINTS))
 
 
 class PhysicalGrasp(GraspBackend):
     """Grasps by contact, held by welds; every object a solid body."""
 
     name = "physical"
-    has_compiled_steps = True
     physics_class = PlayroomPhysics
     solid = True
+    closed_form = False
 
-    # Arm movements ------------------------------------------------------------------------
-    def before_step(
-        self, physics: PlayroomPhysics, joint_targets: np.ndarray, step: int
-    ) -> list[ev.Event]:
-        physics.data.ptr.ctrl[:] = joint_targets
-        return []
+    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
+        if not AVAILABLE:
+            raise RuntimeError(MISSING)
+        super().__init__(config, edits)
+        self._before: np.ndarray | None = None  # the state `begin` saved
 
-    def run_steps(
-        self,
-        physics: PlayroomPhysics,
-        arm_targets: np.ndarray,
-        brought: np.ndarray | None,
-        start: int,
-        positions: np.ndarray,
-        grasping: bool,
-    ) -> int:
-        """`GraspBackend.run_steps`, through PlayroomPhysics.control_steps."""
-        watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
-        return physics.control_steps(start, arm_targets, brought, positions, watched)
+    def begin(self, physics: PlayroomPhysics) -> None:
+        super().begin(physics)
+        # Only the physics changes during the steps: what a divergence puts back.
+        self._before = physics.integration_state()
+
+    # A movement, stepped in compiled code -------------------------------------------------
+    def simulate(
+        self, physics: PlayroomPhysics, movement: Movement, trace: MovementTrace | None
+    ) -> MovementOutcome:
+        """`GraspBackend.simulate`: the control steps in compiled code (sim/compiled_steps.py)
+        between the contacts the grasp acts on (`_take_by_contact`, here in Python). A movement
+        whose physics diverges (MuJoCo warns, or a position is not finite) leaves the room where
+        it was: `diverged_from` is the state `begin` saved."""
+        positions = np.empty((N_STEPS + 1, len(TRACKED_OBJECTS), 2))
+        positions[0] = movement.start
+        grasping = movement.space == ARM
+        # The servos' targets; a vocal movement leaves them at rest.
+        targets = np.ascontiguousarray(movement.controls) if grasping else _NO_TARGETS
+        path = None if movement.brought is None else movement.brought.path
+        warnings = physics.warning_counts()
+        events: list[ev.Event] = []
+
+        def steps_from(k: int) -> int:
+            watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
+            return physics.control_steps(k, targets, path, positions, watched, trace)
+
+        k = steps_from(0)
+        while k < N_STEPS:  # a contact the grasp acts on, after step k
+            events += self._take_by_contact(physics, k + 1)
+            physics.write_tracked_positions(positions[k + 1])  # as the grasp left them
+            if trace is not None:
+                trace.record(k + 1, physics.data.ptr)
+            k = steps_from(k + 1)
+        if (physics.warning_counts() > warnings).any() or not np.isfinite(positions).all():
+            positions[1:] = positions[0]  # the room goes on from where it was
+            if trace is not None:
+                trace.qpos[1:], trace.mocap_pos[1:] = trace.qpos[0], trace.mocap_pos[0]
+            sound, before = movement.sound, self._before
+            return MovementOutcome(positions, sound, [], NOTHING_HELD, diverged_from=before)
+        return MovementOutcome(positions, movement.sound, events, self.holds)
 
     def watched_contacts(self) -> np.ndarray:
         """Indices into GRASP_CONTACTS (sim/physics.py) of the contacts that would take
@@ -73,7 +104,8 @@ class PhysicalGrasp(GraspBackend):
             return _WATCHED_BY_EMPTY_TIP
         return _WATCHED_BY_NOTHING
 
-    def after_step(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+    def _take_by_contact(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
+        """After control step `step` (1-based): what the watched contacts take."""
         watched = self.watched_contacts()
         if watched.size == 0:
             return []
@@ -142,6 +174,11 @@ class PhysicalGrasp(GraspBackend):
         physics.stop_objects()
         arm_to_rest(physics)
 
+    def after_placements(self, physics: PlayroomPhysics) -> None:
+        """Everything the next movement's first step starts from: contacts, constraints and
+        forces, computed for the room as the placements left it."""
+        mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
+
     def settle(self, physics: PlayroomPhysics) -> None:
         """With `settle_between_movements` (an ablation): the room's physics runs
         SETTLE_PHYSICS_STEPS with the arm held at rest before the next movement, so that
@@ -174,10 +211,6 @@ class PhysicalGrasp(GraspBackend):
         self.edits.make_intangible(CAREGIVER, physics.toy_geoms[toy])
         self.edits.lift(CAREGIVER, OBJECTS.index(TOYS[toy]))
         return d.mocap_pos[hand, :2].copy()
-
-    def caregiver_carries(self, physics: PlayroomPhysics, toy: int, place: np.ndarray) -> None:
-        """Her hand moves; the weld brings the toy along through the dynamics."""
-        physics.data.ptr.mocap_pos[physics.caregiver_hand_mocap, :2] = place
 
     def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
         self.edits.clear(CAREGIVER)

@@ -22,18 +22,17 @@ FAR_TOYS = np.array([[-1.2, -1.2], [1.2, 1.2], [-1.2, 1.2]])
 
 
 def _arm_angles_and_hands(grasp: str, commands: list[np.ndarray]) -> tuple[list, list]:
-    """Per command: the (50, 3) joint angles after each control step (read by a step
-    observer) and the feedback's (50, 2) hand path, in an empty room of `grasp`."""
+    """Per command: the (50, 3) joint angles after each control step (read from the
+    movement's trace) and the feedback's (50, 2) hand path, in an empty room of `grasp`."""
     room = Playroom(grasp, seed=0, config=SERVO if grasp == "kinematic" else world_preset("study"))
-    seen: list[np.ndarray] = []
-    room.step_observers.append(lambda step, obs: seen.append(room.physics.arm_angles()))
+    room.tracing = True
     angles, hands = [], []
     for m in commands:
         room.arrange(stick=FAR_STICK, toys=FAR_TOYS)  # placements between iterations undone
-        seen.clear()
         feedback = room.act_arm(m)
         assert not {ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT} & set(feedback.kinds())
-        angles.append(np.array(seen))
+        assert room.last_trace is not None
+        angles.append(room.last_trace.qpos[1:, room.physics.arm_qpos])
         hands.append(feedback.positions[:, 0].copy())
     return angles, hands
 

@@ -1,6 +1,6 @@
 """The physical movement's control steps run compiled (sim/compiled_steps.py): the same numbers,
-events and state as the step-by-step Python loop, and the contact sensors they watch say what
-MuJoCo's contact list says."""
+events, trace and state as the step-by-step Python loop (tests/stepped_oracle.py), and the
+contact sensors they watch say what MuJoCo's contact list says."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scripted import Waypoint, arm_command_through
+from stepped_oracle import use_oracle
 
 from models import playroom_xml
 from models.layout import ARM_DIM, VOICE_DIM
@@ -65,13 +66,17 @@ def _random_scene(room: Playroom) -> list[tuple[str, np.ndarray]]:
 
 def _played(scene, compiled: bool) -> tuple[Playroom, list]:
     room = Playroom("physical", seed=0, config=PROJECT)
-    room.task.compiled_steps = compiled
+    room.tracing = True
+    if not compiled:
+        use_oracle(room)
     feedbacks = []
+    room.traces = []  # type: ignore[attr-defined]
     for space, m in scene(room):
         if space == BRING:
             room.caregiver.start_bringing(room.physics, int(m))
         else:
             feedbacks.append(room.act(space, m))
+            room.traces.append(room.last_trace)  # type: ignore[attr-defined]
     return room, feedbacks
 
 
@@ -84,6 +89,9 @@ def test_compiled_steps_give_the_python_loops_numbers(scene):
         np.testing.assert_array_equal(got.positions, expected.positions)
         np.testing.assert_array_equal(got.sound, expected.sound)
         assert got.events == expected.events
+    for expected, got in zip(python_room.traces, room.traces, strict=True):
+        np.testing.assert_array_equal(got.qpos, expected.qpos)
+        np.testing.assert_array_equal(got.mocap_pos, expected.mocap_pos)
     np.testing.assert_array_equal(room.get_state()["physics"], python_room.get_state()["physics"])
     np.testing.assert_array_equal(room.physics.data.ptr.qacc, python_room.physics.data.ptr.qacc)
     kinds = {kind for f in feedbacks for kind in f.kinds()}
@@ -95,21 +103,25 @@ def test_compiled_steps_give_the_python_loops_numbers(scene):
 
 
 def test_contact_sensors_say_what_the_contact_list_says():
-    room = Playroom("physical", seed=0, config=PROJECT)
+    room = use_oracle(Playroom("physical", seed=0, config=PROJECT))
     scene = _tool_scene(room)
     p = room.physics
     pairs = [(p.hand_geom, p.handle_geom)]
     pairs += [(p.hand_geom, g) for g in p.toy_geoms] + [(p.tip_geom, g) for g in p.toy_geoms]
     seen = []
 
-    def compare(step: int, observation: dict) -> None:
+    write = p.write_tracked_positions
+
+    def compare(out: np.ndarray) -> None:  # after every control step of the oracle's loop
+        write(out)
+        step = len(seen) + 1
         listed = {tuple(sorted(pair)) for pair in p.touching_pairs().tolist()}
         expected = [tuple(sorted(pair)) in listed for pair in pairs]
         sensed = list(p.grasp_contacts() > 0)
         assert sensed == expected, f"step {step}: {dict(zip(GRASP_CONTACTS, sensed, strict=True))}"
         seen.append(sensed)
 
-    room.step_observers.append(compare)
+    p.write_tracked_positions = compare  # type: ignore[method-assign]
     for space, m in scene:
         room.act(space, m)
     touched = np.array(seen).any(axis=0)
@@ -149,7 +161,8 @@ def _voice_after_an_arm_movement(compiled: bool, push_toy: bool) -> tuple[Playro
     """An arm movement, then a voice movement in which the caregiver brings nothing; with
     `push_toy`, a toy is still sliding when the voice movement begins."""
     room = Playroom("physical", seed=0, config=PROJECT)
-    room.task.compiled_steps = compiled
+    if not compiled:
+        use_oracle(room)
     room.act("arm", np.random.default_rng(5).uniform(-1, 1, ARM_DIM))
     if push_toy:
         room.physics.data.qvel[room.physics.object_dof[1, 0]] = 0.5

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scripted import Waypoint, arm_command_through
+from stepped_oracle import use_oracle
 
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
@@ -49,18 +50,16 @@ def _offsets(held_pose: str, scene) -> tuple[list[ev.Event], np.ndarray]:
     (m), as (50, 4)."""
     # The project's DMP: the one scripted commands are fitted to (tests/scripted.py).
     room = Playroom("physical", seed=0, config=world_preset("project", held_pose=held_pose))
+    room.tracing = True
     rows: list[list[float]] = []
-
-    def watch(step: int, observation: dict) -> None:
-        p = room.physics
+    events = room.act_arm(scene(room)).events
+    assert room.last_trace is not None
+    for _, p in room.last_trace.replayed(room.physics):
         stick = p.object_poses()[0]
         hand, tip, toy = p.hand_position(), p.stick_tip(), p.toy_positions()[0]
         turn = (stick[2] - p.hand_angle() + np.pi) % (2 * np.pi) - np.pi
         distance = lambda a, b: float(np.hypot(*(a - b)))  # noqa: E731
         rows.append([distance(stick[:2], hand), abs(turn), distance(toy, tip), distance(toy, hand)])
-
-    room.step_observers.append(watch)
-    events = room.act_arm(scene(room)).events
     return events, np.array(rows)
 
 
@@ -118,12 +117,13 @@ def test_an_aligned_toy_in_the_hand_is_at_the_hand():
 
 
 def test_aligned_holds_give_the_same_numbers_on_every_path():
-    """The compiled steps, the Python loop and the observed dm_control steps (videos) place
-    and weld alike (the placement recomputes the room's forces on every path)."""
+    """The compiled steps and the step-by-step Python loop (tests/stepped_oracle.py) place and
+    weld alike (the placement recomputes the room's forces on both), and trace alike."""
     config = world_preset("project", held_pose="aligned", push_objects=False)
-    rooms = [Playroom("physical", seed=1, config=config) for _ in range(3)]
-    rooms[1].task.compiled_steps = False
-    rooms[2].step_observers.append(lambda step, observation: None)
+    rooms = [Playroom("physical", seed=1, config=config) for _ in range(2)]
+    use_oracle(rooms[1])
+    for room in rooms:
+        room.tracing = True
     rng = np.random.default_rng(1)
     commands = [_tool_use] + [
         ("arm", rng.uniform(-1, 1, ARM_DIM)) if i % 3 else ("voice", rng.uniform(-1, 1, VOICE_DIM))
@@ -139,6 +139,7 @@ def test_aligned_holds_give_the_same_numbers_on_every_path():
             np.testing.assert_array_equal(other.positions, feedbacks[0].positions)
             assert other.events == feedbacks[0].events
             np.testing.assert_array_equal(room.physics.data.qpos, rooms[0].physics.data.qpos)
+            np.testing.assert_array_equal(room.last_trace.qpos, rooms[0].last_trace.qpos)
         kinds.update(feedbacks[0].kinds())
     assert {ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT} <= kinds
 

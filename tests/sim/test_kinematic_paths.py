@@ -1,9 +1,9 @@
-"""The fast paths of a movement give what the step-by-step dm_control path gives.
+"""Each backend's one computation of a movement gives what the step-by-step rules give.
 
-A room without step observers runs the kinematic rules over a whole movement at once
-(sim/grasping/kinematic.py) and steps the physical backend without building observations; a
-room with an observer (a video) goes through the dm_control environment step by step. Both
-must give the same feedback, sample by sample, and the same events, event by event.
+A room runs the kinematic rules over a whole movement at once (sim/grasping/kinematic.py) and
+steps the physical backend in compiled code; a twin room computes its movements with the
+step-by-step oracle (tests/stepped_oracle.py). Both must give the same feedback, sample by
+sample, the same events, event by event, and the same trace, step by step.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import dataclasses
 import numpy as np
 import pytest
 from scripted import Waypoint, arm_command_through
+from stepped_oracle import use_oracle
 
 from models.layout import ARM_DIM, VOICE_DIM
 from sim import Playroom
@@ -26,9 +27,9 @@ STUDY_WORLD = dataclasses.replace(DEFAULT_WORLD, dmp="study", catch_rule="study"
 
 def _twin_rooms(grasp: str, seed: int, config=DEFAULT_WORLD) -> tuple[Playroom, Playroom]:
     fast = Playroom(grasp, seed=seed, config=config)
-    stepped = Playroom(grasp, seed=seed, config=config)
-    stepped.step_observers.append(lambda step, observation: None)
+    stepped = use_oracle(Playroom(grasp, seed=seed, config=config))
     for room in (fast, stepped):
+        room.tracing = True
         _record_holds(room)
     return fast, stepped
 
@@ -56,6 +57,8 @@ def _same(fast: Playroom, stepped: Playroom, space: str, m: np.ndarray) -> list[
     assert fast.holds_spoken_of == stepped.holds_spoken_of
     np.testing.assert_array_equal(fast.context(), stepped.context())
     np.testing.assert_array_equal(fast.physics.object_poses(), stepped.physics.object_poses())
+    np.testing.assert_array_equal(fast.last_trace.qpos, stepped.last_trace.qpos)
+    np.testing.assert_array_equal(fast.last_trace.mocap_pos, stepped.last_trace.mocap_pos)
     return a.kinds()
 
 
@@ -135,7 +138,21 @@ def test_kinematic_whole_movements_equal_the_stepped_rules_on_scripted_tool_use(
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_physical_unobserved_steps_equal_the_environment_steps(seed):
+def test_physical_compiled_steps_equal_the_python_steps(seed):
     fast, stepped = _twin_rooms("physical", seed=seed)
     for space, m in _random_commands(np.random.default_rng(seed), 150):
         _same(fast, stepped, space, m)
+
+
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_tracing_a_movement_changes_nothing_of_it(grasp):
+    """Videos and frames trace the movements; trials do not: the same world either way."""
+    traced, plain = Playroom(grasp, seed=3), Playroom(grasp, seed=3)
+    traced.tracing = True
+    for space, m in _random_commands(np.random.default_rng(3), 40):
+        a, b = traced.act(space, m), plain.act(space, m)
+        np.testing.assert_array_equal(a.s, b.s)
+        np.testing.assert_array_equal(a.positions, b.positions)
+        assert a.events == b.events
+        assert traced.last_trace is not None and plain.last_trace is None
+    np.testing.assert_array_equal(traced.get_state()["physics"], plain.get_state()["physics"])

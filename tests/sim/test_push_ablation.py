@@ -71,7 +71,7 @@ def test_settling_runs_the_physics_between_movements_only_when_asked():
         config = dataclasses.replace(world_preset("study"), settle_between_movements=settle)
         room = Playroom("physical", seed=0, config=config)
         before = room.physics.data.time
-        room.task.end_movement(room.physics)  # what ends every movement
+        room._end_movement()  # what ends every movement
         timestep = room.physics.model.opt.timestep
         assert room.physics.data.time - before == pytest.approx(steps * timestep)
 

@@ -73,34 +73,24 @@ def test_dmp_output_is_bounded_deterministic_and_shaped():
 
 
 # The dm_control task ------------------------------------------------------------------------
-def test_room_is_built_on_a_dm_control_environment():
+def test_room_starts_as_its_dm_control_task_starts_an_episode():
     room = Playroom("physical", seed=0, config=PROJECT)
     assert isinstance(room.task, control.Task)
-    assert isinstance(room.env, control.Environment)
-    assert room.env.action_spec().shape == (10,)
-    # Inside a movement the room began, a step applies its joint targets.
-    rest = room.physics.hand_position().copy()
-    room.task.begin_movement(room.physics, "arm")
-    for _ in range(20):
-        obs = room.env.step(np.r_[np.full(3, 0.5), np.zeros(7)]).observation
+    assert room.task.action_spec(room.physics).shape == (10,)
+    obs = room.task.get_observation(room.physics)
     assert set(obs) == {"hand", "stick_handle", "stick_tip", "toys", "caregiver", "sound"}
     assert obs["toys"].shape == (3, 2)
-    assert np.linalg.norm(obs["hand"] - rest) > 0.1
-    room.task.end_movement(room.physics)
+    # The home keyframe: the arm at rest, the hand straight up from the base.
+    np.testing.assert_allclose(obs["hand"], [0.0, room.config.arm_length], atol=1e-12)
 
 
-def test_room_env_refuses_steps_outside_a_movement_and_resets():
-    # room.env is the room's internal stepping: what would be ignored or put the room out of
-    # step with its own bookkeeping is refused, pointing to sim.envs.
+def test_the_task_refuses_steps_pointing_to_where_commands_go():
+    # Movements are computed whole by the backend: a dm_control step would act outside them.
     room = Playroom("kinematic", seed=0, config=PROJECT)
     state = room.get_state()
-    with pytest.raises(RuntimeError, match="only inside a movement.*sim.envs"):
-        room.env.step(np.r_[np.full(3, 0.5), np.zeros(7)])
-    with pytest.raises(RuntimeError, match="internal stepping.*sim.envs"):
-        room.env.reset()
-    after = room.get_state()
-    np.testing.assert_array_equal(after["physics"], state["physics"])
-    assert after["iteration"] == state["iteration"]
+    with pytest.raises(RuntimeError, match="Playroom.act.*sim.envs"):
+        room.task.before_step(np.r_[np.full(3, 0.5), np.zeros(7)], room.physics)
+    np.testing.assert_array_equal(room.get_state()["physics"], state["physics"])
 
 
 # Scripted motions, found by optimisation over the DMP parameters ---------------------------

@@ -3,6 +3,7 @@ room in it; without a display it says so in one line."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -95,3 +96,36 @@ def test_a_trial_is_viewed_only_within_its_iterations(tmp_path):
         view_trial(tmp_path / "t", start=3, count=1)
     with pytest.raises(ViewError, match="holds no trial"):
         view_trial(tmp_path, start=0, count=1)
+
+
+class _FakeViewer:
+    """What `_Window` uses of MuJoCo's passive viewer, keeping the hand shown at each sync."""
+
+    def __init__(self, shown) -> None:
+        self.shown, self.hands = shown, []
+
+    def is_running(self) -> bool:
+        return True
+
+    def lock(self):
+        return contextlib.nullcontext()
+
+    def sync(self) -> None:
+        self.hands.append(self.shown.hand_position())
+
+
+@pytest.mark.parametrize("grasp", ["kinematic", "physical"])
+def test_the_window_shows_every_step_of_a_movement_then_the_room(grasp):
+    from experiments.video.viewer import _Window
+    from sim import Playroom
+
+    room = Playroom(grasp, seed=0)
+    shown = room.physics.copy(share_model=True)
+    fake = _FakeViewer(shown)
+    window = _Window(room, fake, shown, pace=1000.0)
+    feedback = window.act("arm", np.random.default_rng(0).uniform(-1, 1, 21))
+    hands = np.array(fake.hands)
+    assert len(hands) == 1 + 50 + 1  # the room, each control step, the room again
+    np.testing.assert_allclose(hands[1:51], feedback.positions[:, 0], atol=1e-12)
+    np.testing.assert_array_equal(hands[-1], room.physics.hand_position())
+    np.testing.assert_array_equal(shown.data.ptr.qpos, room.physics.data.ptr.qpos)
