@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import functools
 
-import mujoco
 import numpy as np
 
 from models import playroom_xml
 from models.layout import N_JOINTS
+from sim.mujoco_import import mujoco
 from sim.physics import CONTROL_SUBSTEPS
 
 # The body of models/playroom.xml whose subtree is the arm; every other body of the world is

@@ -28,12 +28,12 @@ import glob
 import os
 from typing import Any
 
-import mujoco
 import numpy as np
 from llvmlite import binding
 from numba import types
 
 from sim.compiled import compiled
+from sim.mujoco_import import mujoco
 
 
 def _mujoco_library() -> str | None:

@@ -20,7 +20,9 @@ import os
 import warnings
 from typing import TYPE_CHECKING, Any
 
-from sim import GL_VARIABLE, environment_kept
+import sim.mujoco_import  # noqa: F401 (mujoco first, its GL library checked)
+from sim.gl_library import GL_VARIABLE
+from sim.process_environment import environment_kept
 
 
 def _imported() -> tuple[Any, Any]:
@@ -40,7 +42,9 @@ else:
     try:
         dm_mujoco, control = _imported()
     except (AttributeError, OSError):
-        if os.environ.get(GL_VARIABLE) is not None:  # the user's choice: sim/__init__.py names it
+        if (
+            os.environ.get(GL_VARIABLE) is not None
+        ):  # the user's choice: sim/mujoco_import.py names it
             raise
         with environment_kept():
             os.environ[GL_VARIABLE] = "disable"  # read once, by this import

@@ -13,9 +13,9 @@ from __future__ import annotations
 from collections import defaultdict
 from dataclasses import dataclass, field
 
-import mujoco
 import numpy as np
 
+from sim.mujoco_import import mujoco
 from sim.physics import PlayroomPhysics
 
 

@@ -17,11 +17,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple, TypeVar
 
-import mujoco
 import numpy as np
 
 from models.layout import N_STEPS
 from sim import events as ev
+from sim.mujoco_import import mujoco
 
 if TYPE_CHECKING:
     from sim.dm_control_import import dm_mujoco

@@ -5,13 +5,13 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from models import playroom_xml
 from models.layout import TOYS
 from sim.config import DEFAULT_WORLD, UNPUSHED_DAMPING_FACTOR, WorldConfig
 from sim.dm_control_import import dm_mujoco
+from sim.mujoco_import import mujoco
 
 if TYPE_CHECKING:
     from sim.movement import MovementTrace

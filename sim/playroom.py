@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from models.layout import (
@@ -24,6 +23,7 @@ from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import load as backend_class
 from sim.model_edits import ModelEdits
 from sim.movement import ARM, VOICE, Movement, MovementOutcome, MovementTrace
+from sim.mujoco_import import mujoco
 from sim.physics import PlayroomPhysics
 from sim.sensory import SAMPLE_STEPS, sensory_from
 from sim.task import PlayroomTask

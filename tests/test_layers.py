@@ -11,8 +11,16 @@ import pytest
 
 SIMULATOR = ("mujoco", "dm_control", "numba", "sim", "learner")
 # What a reader of trials loads of sim: the plain settings dataclasses, whose fields declare
-# what older trials ran with (experiments/config_file.py); no room, no tract.
-SIM_SETTINGS = ("sim", "sim.config", "sim.vocal", "sim.vocal.config")
+# what older trials ran with (experiments/config_file.py), and the package's face (its GL
+# library check and environment guard, plain Python); no room, no tract.
+SIM_SETTINGS = (
+    "sim",
+    "sim.gl_library",
+    "sim.process_environment",
+    "sim.config",
+    "sim.vocal",
+    "sim.vocal.config",
+)
 
 
 @pytest.mark.parametrize(

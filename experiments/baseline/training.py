@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from sim import environment_kept
+from sim.process_environment import environment_kept
 
 # Gymnasium sets PYGAME_HIDE_SUPPORT_PROMPT when first imported; importing the project's
 # packages changes no environment variable (sim/envs/__init__.py does the same).

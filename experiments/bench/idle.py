@@ -12,12 +12,12 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 
-import mujoco
 import numpy as np
 
 from models.layout import ARM_DIM, N_STEPS
 from sim import Playroom
 from sim import events as ev
+from sim.mujoco_import import mujoco
 from sim.physics import CONTROL_SUBSTEPS
 
 _SAMPLES = 200  # timings of the calls after each kind of gap; their median is printed

@@ -3,13 +3,13 @@ servo gains of models/playroom.xml."""
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from models.layout import ARM_DIM, N_STEPS
 from sim.config import DEFAULT_WORLD, WorldConfig
 from sim.dmp import arm_trajectory
 from sim.kinematics import hand_positions
+from sim.mujoco_import import mujoco
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 
 

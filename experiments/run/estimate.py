@@ -37,7 +37,8 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial_files import TrialError
 
 # Seconds of an iteration, by grasp backend: 5293 and 559 iterations a second over trials of
-# 5000 iterations (docs/speed.md, `playroom bench trial`).
+# 5000 iterations (docs/speed.md, `playroom bench trial`, which measures every registered
+# backend). A backend not measured here yet is estimated at the slowest's cost (`_per_iteration`).
 SECONDS_PER_ITERATION = {"kinematic": 1 / 5293, "physical": 1 / 559}
 # A kinematic trial's seconds per iteration near iteration 80000 and near 10^6, measured by
 # `playroom bench long` at commit eebcc93 (docs/speed.md): how the learner's cost grows.

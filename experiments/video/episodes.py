@@ -21,7 +21,6 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-import mujoco
 import numpy as np
 from tqdm import tqdm
 
@@ -35,6 +34,7 @@ from models.tracts import DEFAULT_TRACT
 from sim import Feedback, Playroom
 from sim import events as ev
 from sim.config import world_preset
+from sim.mujoco_import import mujoco
 
 # 50 frames per second shows one 50-step movement in 1 s, which is also its simulated time
 # (20 ms control steps).

@@ -52,7 +52,7 @@ def without_rendering() -> None:
 def unloadable_library(backend: str) -> str | None:
     """The one-line message for a backend whose system library is there but cannot be loaded
     (an empty or broken libEGL.so.1 on a cluster node), else None: sim's check, which the first
-    import of mujoco runs too (sim/__init__.py)."""
+    import of mujoco runs too (sim/mujoco_import.py)."""
     from sim import gl_library_problem
 
     return gl_library_problem(backend)
@@ -65,7 +65,7 @@ def for_viewing() -> None:
     if chosen != "glfw":
         raise GLError(f"the viewer opens a window with GLFW: unset {VARIABLE} (it is {chosen!r})")
     if "mujoco" in sys.modules:
-        import mujoco
+        from sim.mujoco_import import mujoco
 
         loaded = getattr(getattr(mujoco, "GLContext", None), "__module__", "none")
         if loaded.split(".")[-1] != "glfw":
@@ -97,7 +97,7 @@ def for_rendering() -> str:
     if missing is not None:
         raise GLError(missing)
     try:
-        import mujoco
+        from sim.mujoco_import import mujoco
 
         context_class = getattr(mujoco, "GLContext", None)
         if context_class is None:

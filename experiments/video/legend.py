@@ -9,9 +9,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import mujoco
 import numpy as np
 from PIL import ImageDraw, ImageFont
+
+from sim.mujoco_import import mujoco
 
 # What the legend names (as the event captions name it), and the geom whose material gives its
 # colour. The stick is named by its handle, the part the hand grasps and the brightest.

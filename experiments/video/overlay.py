@@ -12,7 +12,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
@@ -24,6 +23,7 @@ from experiments.video.legend import (
 )
 from models.layout import TRACKED_OBJECTS as TRACKED
 from sim import events as ev
+from sim.mujoco_import import mujoco
 
 # Blocks of the sensory space that are object positions (5 x then 5 y, metres); the sixth
 # block, "sound", is not drawn in the room.

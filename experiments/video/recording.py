@@ -13,7 +13,6 @@ import os
 import re
 from collections.abc import Sequence
 
-import mujoco
 import numpy as np
 
 from experiments.video import gl
@@ -21,6 +20,7 @@ from experiments.video.encoding import RenderError
 from experiments.video.overlay import CameraView
 from models.world import Feedback
 from sim import Playroom
+from sim.mujoco_import import mujoco
 from sim.physics import PlayroomPhysics
 
 DEFAULT_SIZE = (640, 480)  # width, height (px)

@@ -14,7 +14,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import mujoco
 import numpy as np
 
 from experiments import storage
@@ -27,6 +26,7 @@ from models.world import Feedback
 from sim import Playroom
 from sim.config import world_preset
 from sim.movement import posed
+from sim.mujoco_import import mujoco
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from sim import environment_kept
+from sim.process_environment import environment_kept
 
 # Gymnasium sets PYGAME_HIDE_SUPPORT_PROMPT when first imported; importing sim changes no
 # environment variable, so it is put back.

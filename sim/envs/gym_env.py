@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import Any
 
 import gymnasium
-import mujoco
 import numpy as np
 from gymnasium import logger, spaces
 
@@ -30,6 +29,7 @@ from sim.envs.rendering import (
 from sim.envs.versions import STUDY_ITERATIONS
 from sim.envs.world import SEED_BOUND, checked_seed, event_dicts
 from sim.grasping.names import DEFAULT_GRASP
+from sim.mujoco_import import mujoco
 from sim.task import ARM, VOICE
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 

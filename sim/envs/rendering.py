@@ -20,10 +20,11 @@ import threading
 import weakref
 from typing import Any
 
-import mujoco
 import numpy as np
 
-from sim import GL_VARIABLE, environment_kept, gl_library_problem
+from sim.gl_library import GL_VARIABLE, gl_library_problem
+from sim.mujoco_import import mujoco
+from sim.process_environment import environment_kept
 
 BACKENDS = ("egl", "osmesa", "glfw")
 DEFAULT_BACKEND = "egl"

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import functools
 
-import mujoco
 import numpy as np
 
 from models.layout import N_STEPS, TOYS, TRACKED_OBJECTS
@@ -35,6 +34,7 @@ from sim.movement import (
     MovementOutcome,
     MovementTrace,
 )
+from sim.mujoco_import import mujoco
 from sim.physics import PlayroomPhysics
 
 

@@ -12,7 +12,6 @@ tip; the weld then holds that pose.
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from models.layout import N_JOINTS, N_STEPS, TOYS, TRACKED_OBJECTS
@@ -23,6 +22,7 @@ from sim.grasping.base import GraspBackend, arm_to_rest
 from sim.kinematics import segment_distance
 from sim.model_edits import ModelEdits
 from sim.movement import ARM, NOTHING_HELD, Movement, MovementOutcome, MovementTrace
+from sim.mujoco_import import mujoco
 from sim.physics import OBJECTS, PlayroomPhysics
 
 # The name under which the caregiver's carrying edits the model (sim/model_edits.py); the
