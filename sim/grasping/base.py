@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.layout import TOYS
 from sim import events as ev
 from sim.config import WorldConfig
 from sim.model_edits import ModelEdits
@@ -104,15 +103,6 @@ class GraspBackend(abc.ABC):
         switches pushing off), `closed_form` (see above)."""
         pushes = self.solid and self.config.push_objects
         return {"solid": self.solid, "pushes": pushes, "closed_form": self.closed_form}
-
-    def _free_toy_mask(self) -> np.ndarray:
-        """(3,) bool: toys that neither the hand nor the stick holds."""
-        free = np.ones(len(TOYS), dtype=bool)
-        if self.stick_holds is not None:
-            free[self.stick_holds] = False
-        if self.hand_holds in TOYS:
-            free[TOYS.index(self.hand_holds)] = False
-        return free
 
 
 @dataclass
