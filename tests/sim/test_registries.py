@@ -82,3 +82,24 @@ def test_the_command_line_offers_each_settings_declared_values():
 def test_a_trial_refuses_a_backend_the_registry_does_not_know():
     with pytest.raises(TrialError, match="kinematic, physical"):
         dataclasses.replace(TrialSettings(), grasp="magnetic")
+
+
+def test_a_third_backend_is_its_module_and_one_registry_line(monkeypatch, tmp_path):
+    """Registered by one line (tests/third_backend.py is its module), a backend runs a trial,
+    which records what it declares; the estimate and the room's paths need nothing else."""
+    from experiments import backend_record, storage
+    from experiments.run import estimate
+    from experiments.run.trial import run_trial
+    from sim.grasping.registry import REGISTRY
+
+    monkeypatch.setitem(REGISTRY, "long_reach", "third_backend:LongReachGrasp")
+    settings = TrialSettings(grasp="long_reach", iterations=300, checkpoint_every=100)
+    trial = run_trial(tmp_path / "trial", settings, progress=False)
+    assert trial.iteration == 300
+    config = storage.read_json(tmp_path / "trial" / "config.json")
+    record = backend_record.read_record(tmp_path / "trial", config)
+    assert record["grasp"] == "long_reach"
+    assert record["reach"] == pytest.approx(trial.room.backend.reach())
+    assert estimate.trial_costs(settings).seconds > 0
+    # Its own rule: the hand takes what lies within twice the study's distance.
+    assert trial.room.backend.config.grasp_distance == 2 * trial.room.config.grasp_distance
