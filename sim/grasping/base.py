@@ -113,8 +113,8 @@ class ArmMovement:
     stick_pose: (3,) handle x, y (m) and yaw (rad) after the movement.
     events: grasps and catches, in step order. holds: what is held at the end.
     angles: (3, N_STEPS) the arm's joint angles after each step (rad, relative to rest);
-    last_segment: (N_STEPS,) the last segment's absolute angle after each step (rad), along
-    which a held stick points.
+    absolute: (3, N_STEPS) the segments' absolute angles after each step (rad): a held stick
+    points along the last one.
     """
 
     positions: np.ndarray
@@ -122,7 +122,7 @@ class ArmMovement:
     events: list[ev.Event]
     holds: Holds
     angles: np.ndarray
-    last_segment: np.ndarray
+    absolute: np.ndarray
 
 
 def arm_to_rest(physics: PlayroomPhysics) -> None:

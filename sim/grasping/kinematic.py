@@ -160,7 +160,7 @@ class KinematicGrasp(GraspBackend):
         if taken is not None:  # the handle in the hand from that step on
             rows = slice(taken - 1, None)
             qpos[rows, stick_x], qpos[rows, stick_y] = positions[taken:, 1].T
-            held_yaw = self.config.arm_rest_offset if arm is None else arm.last_segment[rows]
+            held_yaw = self.config.arm_rest_offset if arm is None else arm.absolute[-1, rows]
             qpos[rows, stick_yaw] = held_yaw
         # An arm movement's toys are where its positions say (an unmoved toy's are its own
         # joints', copied); during a vocal one only the toy she brings moves.
@@ -205,7 +205,7 @@ class KinematicGrasp(GraspBackend):
             answers,
         )
         k, first, on_stick, caught_step, caught_toy = answers.tolist()
-        path = (angles, absolute[-1])
+        path = (angles, absolute)
         events: list[ev.Event] = []
         if on_stick != kernel.NONE:
             events.append(ev.Event(ev.TOY_CAUGHT, 1, obj=TOYS[on_stick], by="stick"))
