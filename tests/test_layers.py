@@ -58,3 +58,15 @@ def test_an_import_loads_only_what_it_needs(statement, not_loaded):
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
     assert loaded.stdout.strip() == ""
+
+
+def test_no_module_of_sim_imports_the_package_or_a_module_that_imports_it_back():
+    """sim's import graph has no cycle, its package `__init__` included (docs/architecture.md,
+    "sim/ inside"): the package's face imports only plain modules, none of which imports it."""
+    import grimp
+
+    graph = grimp.build_graph("sim", include_external_packages=False)
+    assert graph.find_modules_that_directly_import("sim") == set()
+    for module in graph.modules:
+        for imported in graph.find_modules_directly_imported_by(module):
+            assert not graph.chain_exists(imported, module), f"{module} <-> {imported}"
