@@ -88,7 +88,7 @@ def _started(out: Path, settings: BaselineSettings, command: str) -> dict:
     return record
 
 
-def _trained(out: Path) -> dict[str, Any]:
+def trained_toys(out: Path) -> dict[str, Any]:
     """training.json's record of the toys done, each checked against its policy file."""
     path = out / TRAINING_FILE
     if not path.exists():
@@ -134,7 +134,7 @@ def run_baseline(
     try:
         record = _started(out, settings, command or shlex.join(["playroom", "rl-baseline"]))
         _, room = fresh_trial_parts(record["trial"])
-        toys = _trained(out)
+        toys = trained_toys(out)
         if toys and notify is not None:
             notify(f"resuming {out}: the policies of toys {', '.join(sorted(toys))} are done")
         steps = settings.toy_steps()

@@ -102,3 +102,17 @@ def test_a_finished_run_is_refused_and_a_stopped_one_resumes_at_its_first_toy_no
     resumed = json.loads((stopped / TRAINING_FILE).read_text())["toys"]
     assert {t: resumed[t] for t in ("1", "2")} == done and "3" in resumed
     assert (stopped / "eval.json").exists()
+
+
+def test_the_policies_behaviour_is_tallied_beside_random_actions(runs, tmp_path):
+    table = tmp_path / "behaviour.csv"
+    argv = ["rl-behaviour", str(runs / "kinematic"), "--episodes", "2", "--out", str(table)]
+    assert main(argv) == 0
+    rows = pd.read_csv(table)
+    assert len(rows) == 6  # three toys, each by its policy and by random actions
+    assert set(rows["actor"]) == {"policy", "random"} and set(rows["toy"]) == {1, 2, 3}
+    assert (rows["movements"] == 6).all()  # 2 episodes of 3 movements
+    assert rows[["voice", "moved", "reached"]].stack().between(0, 1).all()
+    again = tmp_path / "again.csv"
+    assert main([*argv[:-1], str(again)]) == 0
+    pd.testing.assert_frame_equal(pd.read_csv(again), rows)  # the same episodes, the same acts
