@@ -14,34 +14,30 @@ moved aside into `stale-at-NNNNNNNN/`.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
 from experiments import backend_record, manifest, provenance, storage
-from experiments.config_file import UnknownSettingError, check_known, with_added_settings
 from experiments.file_names import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
-    CONFIG_FILE,
-    LOCK_FILE,
     LOG_DIR,
     LOG_README_FILE,
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.log_layout import CHUNK_IDENTITY_KEY, EXTENSIBLE, chunk_path, source_of
+from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path, source_of
 from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 from experiments.run import estimate, memory_segments, progress_bar, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings, full_config
-from experiments.run.trial_checks import drop_logs_past, is_litter, prepare_resume, remove_litter
 from experiments.run.trial_files import (
     LOG_README,
     WORDS_LOG_PERIOD,
@@ -51,11 +47,15 @@ from experiments.run.trial_files import (
     fresh_trial_parts,
     learner_values,
     log_row,
-    move_derived_aside,
     trial_identity,
     trial_path,
 )
+from experiments.run.trial_opening import open_trial_directory, refuse_foreign_path
 from models.layout import TOYS, block_slice
+
+if TYPE_CHECKING:
+    from learner.agent import Agent
+    from sim.playroom import Playroom
 
 _SOUND = block_slice("sound")
 _TOY_MOVED_BY = tuple(f"{toy}_moved_by" for toy in TOYS)
@@ -72,7 +72,7 @@ class Trial:
         self.identity = trial_identity(self.config)  # carried by every checkpoint and log chunk
         self.source = source_of(self.dir, self.config)  # first in every log row
         self.notices: list[str] = []  # one line each: what a resume had to do
-        self._refuse_foreign_path()
+        refuse_foreign_path(self.dir)
         try:
             self._lock = DirectoryLock(self.dir).acquire()
         except DirectoryLocked as exc:
@@ -83,7 +83,7 @@ class Trial:
             # Built before anything is written: a config that makes no room or agent leaves
             # the directory as it was.
             self.agent, self.room = fresh_trial_parts(self.config)
-            self._check_directory(resume)
+            restored = open_trial_directory(self.dir, self.config, resume, self.notices)
             self.iteration = 0
             self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
             self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
@@ -96,8 +96,8 @@ class Trial:
             self.manifest_pointer: dict | None = None
             self.recorded: manifest.Manifest | None = None
             self.unrecorded: list[Path] = []
-            if resume:
-                self._resume()
+            if restored is not None:
+                self._continue_from(*restored)
             readme = self.dir / LOG_DIR / LOG_README_FILE
             if not readme.exists():  # a new trial's, or an old one's moved into the folders
                 storage.write_text(readme, LOG_README)
@@ -127,58 +127,6 @@ class Trial:
         path = self.dir / BACKEND_FILE
         if self.recorded is None or path not in self.recorded:
             self.unrecorded.append(path)
-
-    # Directory rules ----------------------------------------------------------------------
-    def _refuse_foreign_path(self) -> None:
-        """Before anything is written: a file, or a folder of something else, is refused (a
-        folder of a new trial killed while writing its first file holds the lock and that
-        file's temporary: it is the same command's to use again)."""
-        d = self.dir
-        if d.exists() and not d.is_dir():
-            raise TrialError(f"{d} is a file, not a directory")
-        if d.is_dir() and not (d / CONFIG_FILE).exists():
-            if any(p.name != LOCK_FILE and not is_litter(p.name) for p in d.iterdir()):
-                raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
-
-    def _check_directory(self, resume: bool) -> None:
-        d = self.dir
-        config_path = d / CONFIG_FILE
-        if config_path.exists():
-            if not resume:
-                raise TrialError(
-                    f"{d} already holds a trial; add --resume to continue it, or choose a new "
-                    "directory"
-                )
-            held = with_added_settings(storage.read_json(config_path))
-            try:
-                check_known(held, config_path)
-            except UnknownSettingError as exc:
-                raise TrialError(str(exc)) from None
-            diff = [
-                f"{key}: {a!r} != {b!r}"
-                for key, a, b in storage.config_differences(held, self.config)
-                if key not in EXTENSIBLE
-            ]
-            if diff:
-                raise TrialError(
-                    f"{d} holds a trial of another configuration ({'; '.join(diff[:4])}); "
-                    "refusing to mix them"
-                )
-        try:
-            (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
-            storage.check_writable(d)
-        except OSError as exc:
-            raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
-        if not config_path.exists():
-            remove_litter(d)  # under the lock: a killed first write's (`_refuse_foreign_path`)
-            try:
-                storage.write_json(config_path, self.config)
-            except OSError:
-                # A new trial whose first file cannot be written (disk full) leaves its folder
-                # as it found it, so that the same command can start it later.
-                with contextlib.suppress(OSError):
-                    (d / LOG_DIR).rmdir()  # made just above; empty, or rmdir refuses
-                raise
 
     @property
     def finished(self) -> bool:
@@ -224,44 +172,21 @@ class Trial:
         self.memory = memory
         self.manifest_pointer, self.unrecorded = pointer, []
 
-    def _resume(self) -> None:
-        """Load the newest usable checkpoint (its logs checked before anything is changed),
-        drop the logs past it and the litter of killed writers, and extend the trial if more
-        iterations are asked for than it was run with."""
-        restored = prepare_resume(self.dir, self.config, self.notices)
-        if restored is not None:
-            self.agent, self.room, meta, self.recorded = restored
-            self.iteration = int(meta["iteration"])
-            self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
-            self.counts = dict(meta["counts"])
-            self.memory = memory_segments.on_disk(meta)
-            self.source["trial"] = created_as(self.dir, meta, str(self.source["trial"]))
-            self.manifest_pointer = meta.get(manifest.MANIFEST_KEY)
-        # The lost work's, past the checkpoint: rewritten by the run.
-        drop_logs_past(self.dir, self.iteration)
-        memory_segments.drop_segments_past(self.dir, self.iteration)
-        manifest.drop_past(self.dir, self.iteration)
-        if restored is not None and self.manifest_pointer is None:
+    def _continue_from(
+        self, agent: Agent, room: Playroom, meta: dict, recorded: manifest.Manifest | None
+    ) -> None:
+        """The trial as the checkpoint a resume restored left it (`open_trial_directory`)."""
+        self.agent, self.room, self.recorded = agent, room, recorded
+        self.iteration = int(meta["iteration"])
+        self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
+        self.counts = dict(meta["counts"])
+        self.memory = memory_segments.on_disk(meta)
+        self.source["trial"] = created_as(self.dir, meta, str(self.source["trial"]))
+        self.manifest_pointer = meta.get(manifest.MANIFEST_KEY)
+        if self.manifest_pointer is None:
             # A trial written before manifests: its next checkpoint records every data file
             # it holds, as checked by the resume, and it is checked from then on.
             self.unrecorded = manifest.data_files(self.dir)
-        self._extend_if_asked()
-
-    def _extend_if_asked(self) -> None:
-        config_path = self.dir / CONFIG_FILE
-        stored = storage.read_json(config_path)
-        asked, stored_total = self.settings.iterations, stored["trial"]["iterations"]
-        if asked == stored_total:
-            return
-        if asked < self.iteration:
-            raise TrialError(
-                f"{self.dir} holds {self.iteration} iterations already; --iterations {asked} "
-                "would shorten it"
-            )
-        moved = move_derived_aside(self.dir, self.iteration)
-        if moved:
-            self.notices.append(f"extended from {stored_total} to {asked} iterations; {moved}")
-        storage.write_json(config_path, self.config)
 
     # The loop -----------------------------------------------------------------------------
     def run(
@@ -288,7 +213,8 @@ class Trial:
         """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
         if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
             # A checkpoint before the first log chunk: a directory with logs then always has
-            # a checkpoint, unless it was lost, and a resume can tell which (`_resume`).
+            # a checkpoint, unless it was lost, and a resume can tell which
+            # (experiments/run/trial_checks.py, `prepare_resume`).
             self._save_checkpoint()
         rows: list[tuple[dict, np.ndarray]] = []
         word_rows: list[dict] = []

@@ -264,9 +264,11 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     return removed
 
 
-def prepare_resume(
-    trial_dir: Path, config: dict, notices: list[str]
-) -> tuple[Agent, Playroom, dict, manifest.Manifest | None] | None:
+# What a resume starts from: the agent, the room, the checkpoint's meta and its manifest.
+Restored = tuple[Agent, Playroom, dict, manifest.Manifest | None]
+
+
+def prepare_resume(trial_dir: Path, config: dict, notices: list[str]) -> Restored | None:
     """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
     checkpoint from before manifests) of the newest usable checkpoint whose logs are whole
     and as recorded, or None to start from iteration 0 (no checkpoint and no
