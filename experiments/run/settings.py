@@ -15,7 +15,7 @@ import os
 from dataclasses import dataclass
 from importlib.metadata import version
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from experiments import storage
 from experiments.config_file import WORLD_CHOICES
@@ -129,6 +129,17 @@ def _check_overrides(overrides: object) -> None:
             )
 
 
+class TypedConfig(NamedTuple):
+    """A trial's settings typed once: its world, voice and learner configs, from which its room
+    and agent are built (`trial_files.trial_parts`), and `json`, the same as config.json holds
+    them."""
+
+    world: WorldConfig
+    voice: VoiceConfig
+    learner: LearnerConfig
+    json: dict
+
+
 def full_config(
     settings: TrialSettings,
     world: WorldConfig | None = None,
@@ -138,6 +149,17 @@ def full_config(
     """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
     the trial's room and agent from. Every value is checked here, before a trial writes
     anything: TrialError (one line) naming the setting and what it allows."""
+    return typed_config(settings, world, voice, learner).json
+
+
+def typed_config(
+    settings: TrialSettings,
+    world: WorldConfig | None = None,
+    voice: VoiceConfig = DEFAULT_VOICE,
+    learner: LearnerConfig | None = None,
+) -> TypedConfig:
+    """`full_config`, with the typed configs it was made from (a run builds its room and agent
+    from these, without reading its own JSON back)."""
     changes = settings.overrides
     try:
         learner = learner or learner_preset(
@@ -178,7 +200,8 @@ def full_config(
     }
     # Through JSON and back, so that it compares equal to what config.json holds; strict JSON
     # (no NaN or Infinity), as storage.write_json writes it.
-    return json.loads(json.dumps(config, allow_nan=False))
+    as_json = json.loads(json.dumps(config, allow_nan=False))
+    return TypedConfig(world, voice, learner, as_json)
 
 
 def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialSettings:

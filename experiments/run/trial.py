@@ -37,17 +37,17 @@ from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path, source_of
 from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 from experiments.run import estimate, memory_segments, progress_bar, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings, typed_config
 from experiments.run.trial_files import (
     LOG_README,
     WORDS_LOG_PERIOD,
     TrialError,
     TrialLocked,
     created_as,
-    fresh_trial_parts,
     learner_values,
     log_row,
     trial_identity,
+    trial_parts,
     trial_path,
 )
 from experiments.run.trial_opening import open_trial_directory, refuse_foreign_path
@@ -68,7 +68,8 @@ class Trial:
     def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
         self.dir = trial_path(out_dir)
         self.settings = settings
-        self.config = full_config(settings)
+        typed = typed_config(settings)  # the settings typed once, here
+        self.config = typed.json
         self.identity = trial_identity(self.config)  # carried by every checkpoint and log chunk
         self.source = source_of(self.dir, self.config)  # first in every log row
         self.notices: list[str] = []  # one line each: what a resume had to do
@@ -82,7 +83,9 @@ class Trial:
         try:
             # Built before anything is written: a config that makes no room or agent leaves
             # the directory as it was.
-            self.agent, self.room = fresh_trial_parts(self.config)
+            self.agent, self.room = trial_parts(
+                settings.grasp, settings.seed, typed.world, typed.voice, typed.learner
+            )
             restored = open_trial_directory(self.dir, self.config, resume, self.notices)
             self.iteration = 0
             self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)

@@ -164,23 +164,28 @@ def trial_path(out_dir: str | os.PathLike) -> Path:
 
 
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
-    """The agent and room of a trial's iteration 0, as its config makes them. TrialConfigError
-    (one line) for a config that makes none: a config.json edited by hand, or written before the
-    configs checked their settings."""
+    """The agent and room of a trial's iteration 0, as its config (config.json's form) makes
+    them. TrialConfigError (one line) for a config that makes none: a config.json edited by
+    hand, or written before the configs checked their settings."""
     try:
         settings = config["trial"]
-        room = Playroom(
-            grasp=settings["grasp"],
-            seed=settings["seed"],
-            config=config_from_dict(WorldConfig, config["world"]),
-            voice=config_from_dict(VoiceConfig, config["voice"]),
-        )
-        agent = Agent(
+        return trial_parts(
+            settings["grasp"],
+            settings["seed"],
+            config_from_dict(WorldConfig, config["world"]),
+            config_from_dict(VoiceConfig, config["voice"]),
             LearnerConfig.from_dict(config["learner"]),
-            np.random.default_rng([settings["seed"], AGENT_STREAM]),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
+
+
+def trial_parts(
+    grasp: str, seed: int, world: WorldConfig, voice: VoiceConfig, learner: LearnerConfig
+) -> tuple[Agent, Playroom]:
+    """The agent and room of a trial's iteration 0 from its typed configs."""
+    room = Playroom(grasp=grasp, seed=seed, config=world, voice=voice)
+    agent = Agent(learner, np.random.default_rng([seed, AGENT_STREAM]))
     return agent, room
 
 
