@@ -6,10 +6,10 @@ what she says (`speak`), what she hears (`hear`), where she brings a toy (`targe
 (`brought_path`, the positions of the whole way, which the backends follow).
 
 The words themselves (vowel targets, recognition distances) are the voice's (sim/vocal/words.py);
-which word names which toy is hers, drawn once per room. How a toy she brings follows her path
-is the grasp backend's (sim/grasping/): carried by her hand, a mocap body welded to the toy,
-lifted above the table, in the physical backend; placed directly, as in the study, in the
-kinematic one.
+which word names which toy is hers, drawn once per room. What she does with a toy she brings is
+her backend's carrying part (sim/grasping/carrying.py): carried by her hand, a mocap body welded
+to the toy, lifted above the table, in the physical backend; placed directly, as in the study,
+in the kinematic one; each backend's `simulate` follows her path.
 """
 
 from __future__ import annotations
@@ -73,7 +73,7 @@ class Caregiver:
         vocal_tract: Voice,
         rng: np.random.Generator,
     ) -> None:
-        self.backend = backend  # how she carries a toy
+        self.carrying = backend.carrying  # how she carries a toy in this world
         self.config = config
         self.vocal_tract = vocal_tract
         self.words: WordAssignment = assign_words(rng, vocal_tract.config)
@@ -122,7 +122,7 @@ class Caregiver:
     def start_bringing(self, physics: PlayroomPhysics, toy: int) -> None:
         """Take toy `toy` (0-based) and bring it over the coming control steps."""
         self.bringing = toy
-        start = self.backend.caregiver_takes(physics, toy)
+        start = self.carrying.takes(physics, toy)
         self.path = brought_path(start, self.target(physics), self.config.caregiver_bring_rate)
 
     @property
@@ -136,6 +136,6 @@ class Caregiver:
         """Put the toy down where it is."""
         if self.bringing is None:
             return
-        self.backend.caregiver_puts_down(physics)
+        self.carrying.puts_down(physics)
         self.bringing = None
         self.path = None

@@ -1,11 +1,12 @@
 """What every grasp backend offers the room: the interface, and what the backends share.
 
 A backend decides how the world moves: what the arm does with its joint targets, what the hand
-and the stick's tip take, how the caregiver carries a toy she brings, and when the stick has
-left the hand's reach. It computes a whole movement one way (`simulate`), returning what it did
-and, when asked, its trace (sim/movement.py); `release(physics)` ends a movement: everything
-held is dropped where it is and the arm goes back to rest. The step-by-step Python forms of
-the backends' rules, the oracle they are held to bit for bit, are tests/sim/stepped_oracle.py.
+and the stick's tip take, and when the stick has left the hand's reach; how the caregiver
+carries a toy she brings is a part of its own (`carrying`, sim/grasping/carrying.py). It
+computes a whole movement one way (`simulate`), returning what it did and, when asked, its
+trace (sim/movement.py); `release(physics)` ends a movement: everything held is dropped where
+it is and the arm goes back to rest. The step-by-step Python forms of the backends' rules, the
+oracle they are held to bit for bit, are in tests/stepped_oracle.py.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 
 from sim import events as ev
 from sim.config import WorldConfig
+from sim.grasping.carrying import Carrying
 from sim.model_edits import ModelEdits
 from sim.movement import NOTHING_HELD, Holds, Movement, MovementOutcome, MovementTrace
 from sim.physics import PlayroomPhysics
@@ -38,6 +40,8 @@ class GraspBackend(abc.ABC):
     physics_class: type[PlayroomPhysics] = PlayroomPhysics
     solid: bool
     closed_form: bool
+    # How the caregiver carries a toy she brings in this world (sim/grasping/carrying.py).
+    carrying: Carrying
 
     def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
         self.config = config
@@ -75,16 +79,6 @@ class GraspBackend(abc.ABC):
     def after_placements(self, physics: PlayroomPhysics) -> None:
         """Between iterations, after the experimenter and the caregiver placed things: MuJoCo's
         derived quantities brought up to what the next movement reads."""
-
-    # The caregiver bringing a toy (sim/caregiver.py) --------------------------------------
-    @abc.abstractmethod
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
-        """She takes toy `toy` (0-based) to bring it over the coming control steps. Returns
-        (2,) where what she moves starts: her path (`Caregiver`) begins there."""
-
-    @abc.abstractmethod
-    def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
-        """She puts the toy down where it is."""
 
     # The experimenter (sim/experimenter.py) -----------------------------------------------
     @abc.abstractmethod

@@ -23,6 +23,7 @@ from sim import events as ev
 from sim.arm_servo import ArmServo
 from sim.config import WorldConfig
 from sim.grasping.base import ArmMovement, GraspBackend
+from sim.grasping.carrying import PlacedCarrying
 from sim.kinematics import hand_positions
 from sim.model_edits import ModelEdits
 from sim.movement import (
@@ -88,6 +89,7 @@ class KinematicGrasp(GraspBackend):
 
     def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
         super().__init__(config, edits)
+        self.carrying = PlacedCarrying()
         # The servo-driven arm under arm_dynamics "servo"; None: the arm is set to its targets.
         self._servo = ArmServo() if config.arm_dynamics == "servo" else None
 
@@ -246,15 +248,6 @@ class KinematicGrasp(GraspBackend):
         if self.config.catch_rule != "study":
             return False
         return bool(np.hypot(*(stick_pose[:2] - hand)) < self.config.grasp_distance)
-
-    # The caregiver bringing a toy: placed directly along her path, as in the study -------
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
-        """Nothing to take: the toy itself is placed at every step; its path starts where it
-        lies."""
-        return physics.object_poses()[1 + toy, :2]
-
-    def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
-        """Nothing to undo: the toy lies where it was last placed."""
 
     # The experimenter ---------------------------------------------------------------------
     def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:

@@ -19,15 +19,13 @@ from sim import events as ev
 from sim.compiled_steps import AVAILABLE, MISSING
 from sim.config import SETTLE_PHYSICS_STEPS, WorldConfig
 from sim.grasping.base import GraspBackend, arm_to_rest
+from sim.grasping.carrying import WeldedCarrying
 from sim.kinematics import segment_distance
 from sim.model_edits import ModelEdits
 from sim.movement import ARM, NOTHING_HELD, Movement, MovementOutcome, MovementTrace
 from sim.mujoco_import import mujoco
 from sim.physics import OBJECTS, PlayroomPhysics
 
-# The name under which the caregiver's carrying edits the model (sim/model_edits.py); the
-# grasps edit it under the backend's name.
-CAREGIVER = "caregiver"
 # Where GRASP_CONTACTS (sim/physics.py) holds each kind of contact.
 HAND_ON_HANDLE = 0
 HAND_ON_TOYS = slice(1, 1 + len(TOYS))
@@ -50,6 +48,7 @@ class PhysicalGrasp(GraspBackend):
         if not AVAILABLE:
             raise RuntimeError(MISSING)
         super().__init__(config, edits)
+        self.carrying = WeldedCarrying(edits)
         self._before: np.ndarray | None = None  # the state `begin` saved
 
     def begin(self, physics: PlayroomPhysics) -> None:
@@ -196,27 +195,6 @@ class PhysicalGrasp(GraspBackend):
         physics.advance(SETTLE_PHYSICS_STEPS)
         physics.stop_objects()
         arm_to_rest(physics)
-
-    # The caregiver bringing a toy ---------------------------------------------------------
-    def caregiver_takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
-        """Her hand goes to the toy and takes it; her path starts there."""
-        m, d = physics.model.ptr, physics.data.ptr
-        hand = physics.caregiver_hand_mocap
-        d.mocap_pos[hand, :2] = physics.toy_positions()[toy]
-        mujoco.mj_kinematics(m, d)
-        # Her hand sits on the toy: the weld holds it there, upright.
-        self.edits.weld_here(CAREGIVER, f"caregiver_{TOYS[toy]}", keep_orientation=False)
-        # She lifts the toy: while carried it touches nothing, as a toy carried above the
-        # table would not (dragged along the table it would sweep the stick out of reach).
-        self.edits.make_intangible(CAREGIVER, physics.toy_geoms[toy])
-        self.edits.lift(CAREGIVER, OBJECTS.index(TOYS[toy]))
-        return d.mocap_pos[hand, :2].copy()
-
-    def caregiver_puts_down(self, physics: PlayroomPhysics) -> None:
-        self.edits.clear(CAREGIVER)
-        d = physics.data.ptr
-        physics.stop_objects()
-        d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
 
     # The experimenter ---------------------------------------------------------------------
     def stick_out_of_reach(self, physics: PlayroomPhysics) -> bool:
