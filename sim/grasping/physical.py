@@ -1,38 +1,28 @@
-"""Grasping through MuJoCo contacts (docs/protocol.md §11 D16): position servos track the arm's
-targets through the dynamics; the hand takes the stick when it touches the handle geom, or a toy
-when it touches it; the stick's tip catches a toy it touches. A grasp activates a weld equality
-holding the current relative pose. Unheld objects are pushed by whatever touches them. The
-caregiver carries a toy with her hand, a mocap body welded to it, lifted above the table.
-
-Under `WorldConfig.held_pose` "aligned" (a rung of the contact ladder) what is taken
-is first placed where the kinematic rules hold it (sim/grasping/kinematic.py): the stick's
-handle at the hand, the stick along the last segment; a toy at the hand, or at the held stick's
-tip; the weld then holds that pose.
+"""Grasping through MuJoCo contacts (docs/protocol.md §11 D16), the physical backend: position
+servos track the arm's targets through the dynamics, every object a solid body pushed by
+whatever touches it; a movement's control steps run compiled (sim/compiled_steps.py), returning
+here when a contact its grasp rule acts on appears. Its parts: the grasp rule
+(sim/grasping/contact_rule.py: what a touch takes, held by welds) and the caregiver's carrying
+(sim/grasping/carrying.py: her hand welded to the toy, lifted above the table).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from models.layout import N_JOINTS, N_STEPS, TOYS, TRACKED_OBJECTS
+from models.layout import N_JOINTS, N_STEPS, TRACKED_OBJECTS
 from sim import events as ev
 from sim.compiled_steps import AVAILABLE, MISSING
 from sim.config import SETTLE_PHYSICS_STEPS, WorldConfig
 from sim.grasping.base import GraspBackend, arm_to_rest
 from sim.grasping.carrying import WeldedCarrying
+from sim.grasping.contact_rule import WATCHED_BY_NOTHING, ContactRule
 from sim.kinematics import segment_distance
 from sim.model_edits import ModelEdits
 from sim.movement import ARM, NOTHING_HELD, Movement, MovementOutcome, MovementTrace
 from sim.mujoco_import import mujoco
-from sim.physics import OBJECTS, PlayroomPhysics
+from sim.physics import PlayroomPhysics
 
-# Where GRASP_CONTACTS (sim/physics.py) holds each kind of contact.
-HAND_ON_HANDLE = 0
-HAND_ON_TOYS = slice(1, 1 + len(TOYS))
-TIP_ON_TOYS = slice(1 + len(TOYS), 1 + 2 * len(TOYS))
-_WATCHED_BY_EMPTY_HAND = np.arange(TIP_ON_TOYS.start)
-_WATCHED_BY_EMPTY_TIP = np.arange(TIP_ON_TOYS.start, TIP_ON_TOYS.stop)
-_WATCHED_BY_NOTHING = np.empty(0, dtype=np.int64)
 _NO_TARGETS = np.empty((0, N_JOINTS))
 
 
@@ -48,6 +38,7 @@ class PhysicalGrasp(GraspBackend):
         if not AVAILABLE:
             raise RuntimeError(MISSING)
         super().__init__(config, edits)
+        self.rule = ContactRule(config, edits, self.name)
         self.carrying = WeldedCarrying(edits)
         self._before: np.ndarray | None = None  # the state `begin` saved
 
@@ -74,7 +65,7 @@ class PhysicalGrasp(GraspBackend):
         events: list[ev.Event] = []
 
         def steps_from(k: int) -> int:
-            watched = self.watched_contacts() if grasping else _WATCHED_BY_NOTHING
+            watched = self.watched_contacts() if grasping else WATCHED_BY_NOTHING
             return physics.control_steps(k, targets, path, positions, watched, trace)
 
         k = steps_from(0)
@@ -93,78 +84,14 @@ class PhysicalGrasp(GraspBackend):
         return MovementOutcome(positions, movement.sound, events, self.holds)
 
     def watched_contacts(self) -> np.ndarray:
-        """Indices into GRASP_CONTACTS (sim/physics.py) of the contacts that would take
-        something now: with the hand empty, the hand on the handle or on a toy; with the stick
-        in the hand and nothing on its tip, the tip on a toy; otherwise none. (In both first
-        cases every toy is free: nothing else holds one.)"""
-        if self.hand_holds is None:
-            return _WATCHED_BY_EMPTY_HAND
-        if self.hand_holds == "stick" and self.stick_holds is None:
-            return _WATCHED_BY_EMPTY_TIP
-        return _WATCHED_BY_NOTHING
+        """The contacts that would take something now (`ContactRule.watched`)."""
+        return self.rule.watched(self.holds)
 
     def _take_by_contact(self, physics: PlayroomPhysics, step: int) -> list[ev.Event]:
         """After control step `step` (1-based): what the watched contacts take."""
-        watched = self.watched_contacts()
-        if watched.size == 0:
-            return []
-        found = physics.grasp_contacts() > 0
-        if not found[watched].any():
-            return []
-        # Wherever a contact is watched every toy is free (`watched_contacts`).
-        events: list[ev.Event] = []
-        if self.hand_holds is None:
-            toys = found[HAND_ON_TOYS]
-            if found[HAND_ON_HANDLE]:
-                self.hand_holds = "stick"
-                self._hold(physics, "hand_stick", "stick")
-                events.append(ev.Event(ev.STICK_GRASPED, step, obj="stick", by="hand"))
-                if self.config.held_pose == "aligned":  # the tip is where the stick now lies
-                    found = physics.grasp_contacts() > 0
-            elif toys.any():
-                toy = TOYS[int(np.argmax(toys))]
-                self.hand_holds = toy
-                self._hold(physics, f"hand_{toy}", toy)
-                events.append(ev.Event(ev.TOY_GRASPED, step, obj=toy, by="hand"))
-        # A stick lying on the table catches nothing: only a stick in the hand is a tool. (The
-        # hand may have taken it in this very step: its tip then catches in this step too.)
-        if self.hand_holds == "stick" and self.stick_holds is None:
-            toys = found[TIP_ON_TOYS]
-            if toys.any():
-                self.stick_holds = int(np.argmax(toys))
-                toy = TOYS[self.stick_holds]
-                self._hold(physics, f"stick_{toy}", toy)
-                events.append(ev.Event(ev.TOY_CAUGHT, step, obj=toy, by="stick"))
+        holds, events = self.rule.take(physics, self.holds, step)
+        self.hand_holds, self.stick_holds = holds
         return events
-
-    def _hold(self, physics: PlayroomPhysics, weld: str, obj: str) -> None:
-        """Weld `obj` where it is to its holder, lift it off the table (no table friction while
-        carried), and stop it colliding with its holder (and only with it).
-
-        MuJoCo makes a contact when one geom's contype meets the other's conaffinity, so a
-        holder and its object each lose the other's bit from their conaffinity.
-        """
-        holder = weld.split("_")[0]
-        if self.config.held_pose == "aligned":
-            _place_as_the_rules_hold(physics, holder, obj)
-        self.edits.weld_here(self.name, weld)
-        self.edits.lift(self.name, OBJECTS.index(obj))
-        holder_geoms = [physics.hand_geom] if holder == "hand" else list(physics.stick_geoms)
-        object_geoms = (
-            list(physics.stick_geoms) if obj == "stick" else [physics.toy_geoms[TOYS.index(obj)]]
-        )
-        # The collision bit of a kind of geom is its contype in the MJCF model.
-        holder_bit = self.edits.compiled_contype(holder_geoms[0])
-        object_bit = self.edits.compiled_contype(object_geoms[0])
-        for geom in holder_geoms:
-            self.edits.ignore(self.name, geom, object_bit)
-        for geom in object_geoms:
-            self.edits.ignore(self.name, geom, holder_bit)
-        if self.config.held_pose == "aligned":
-            # Everything the next physics step starts from, computed for the room as it is now
-            # (the object moved, the weld on, its collisions edited): without it that step
-            # would integrate contact forces found with the object where the touch left it.
-            mujoco.mj_forward(physics.model.ptr, physics.data.ptr)
 
     def release(self, physics: PlayroomPhysics) -> None:
         self.hand_holds = None
@@ -226,18 +153,3 @@ class PhysicalGrasp(GraspBackend):
         sizes = physics.model.ptr.geom_size
         contact = sizes[physics.hand_geom, 0] + sizes[physics.handle_geom, 0]
         return float(self.config.arm_length + contact)
-
-
-def _place_as_the_rules_hold(physics: PlayroomPhysics, holder: str, obj: str) -> None:
-    """Put `obj` where the kinematic rules hold what `holder` ("hand" or "stick") takes: the
-    stick's handle at the hand, pointing along the last segment; a toy at the hand or at the
-    stick's tip, its yaw kept. Still, with the positions updated (the weld reads them)."""
-    row = OBJECTS.index(obj)
-    place = physics.hand_position() if holder == "hand" else physics.stick_tip()
-    d = physics.data.ptr
-    qpos, dof = physics.object_qpos[row], physics.object_dof[row]
-    d.qpos[qpos[:2]] = place
-    if obj == "stick":
-        d.qpos[qpos[2]] = physics.hand_angle()
-    d.qvel[dof] = 0.0
-    mujoco.mj_kinematics(physics.model.ptr, d)
