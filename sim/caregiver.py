@@ -77,9 +77,9 @@ class Caregiver:
         self.config = config
         self.vocal_tract = vocal_tract
         self.words: WordAssignment = assign_words(rng, vocal_tract.config)
-        self.bringing: int | None = None  # index of the toy she is bringing
-        # Where the toy she brings is after each control step of this movement, (N_STEPS, 2).
-        self.path: np.ndarray | None = None
+        # The toy she brings during this movement (0-based) and where it is to be after each
+        # control step, or None.
+        self.brought: Brought | None = None
 
     # Where she stands ----------------------------------------------------------------------
     def place(self, physics: PlayroomPhysics, rng: np.random.Generator) -> None:
@@ -121,21 +121,18 @@ class Caregiver:
     # How she brings a toy ------------------------------------------------------------------
     def start_bringing(self, physics: PlayroomPhysics, toy: int) -> None:
         """Take toy `toy` (0-based) and bring it over the coming control steps."""
-        self.bringing = toy
         start = self.carrying.takes(physics, toy)
-        self.path = brought_path(start, self.target(physics), self.config.caregiver_bring_rate)
+        path = brought_path(start, self.target(physics), self.config.caregiver_bring_rate)
+        self.brought = Brought(toy, path)
 
     @property
-    def brought(self) -> Brought | None:
-        """The toy she brings during this movement and her path, or None."""
-        if self.bringing is None or self.path is None:
-            return None
-        return Brought(self.bringing, self.path)
+    def bringing(self) -> int | None:
+        """The index of the toy she is bringing, or None."""
+        return None if self.brought is None else self.brought.toy
 
     def stop(self, physics: PlayroomPhysics) -> None:
         """Put the toy down where it is."""
-        if self.bringing is None:
+        if self.brought is None:
             return
         self.carrying.puts_down(physics)
-        self.bringing = None
-        self.path = None
+        self.brought = None

@@ -113,12 +113,26 @@ def posed(
     model: mujoco.MjModel, data: mujoco.MjData, trace: MovementTrace, step: int
 ) -> mujoco.MjData:
     """`data` (a scratch MjData of `model`, never the room's own) put where the room was after
-    control step `step` of `trace`, every derived quantity computed (mj_forward): what a frame,
-    a viewer or a contact list of that step reads. The mocap bodies' orientations are left as
+    control step `step` of `trace` (`posed_as`). The mocap bodies' orientations are left as
     `data` holds them (no movement turns one)."""
-    data.qpos[:] = trace.qpos[step]
+    return posed_as(model, data, trace.qpos[step], trace.mocap_pos[step])
+
+
+def posed_as(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    qpos: np.ndarray,
+    mocap_pos: np.ndarray,
+    mocap_quat: np.ndarray | None = None,
+) -> mujoco.MjData:
+    """`data` (a scratch MjData of `model`) put still at these joint and mocap positions (and
+    orientations, if given), every derived quantity computed (mj_forward): what a frame, a
+    viewer or a contact list reads."""
+    data.qpos[:] = qpos
     data.qvel[:] = 0.0
-    data.mocap_pos[:] = trace.mocap_pos[step]
+    data.mocap_pos[:] = mocap_pos
+    if mocap_quat is not None:
+        data.mocap_quat[:] = mocap_quat
     mujoco.mj_forward(model, data)
     return data
 

@@ -25,8 +25,7 @@ from models.presets import DEFAULT_PRESET
 from models.world import Feedback
 from sim import Playroom
 from sim.config import world_preset
-from sim.movement import posed
-from sim.mujoco_import import mujoco
+from sim.movement import posed, posed_as
 from sim.physics import CONTROL_SUBSTEPS, PlayroomPhysics
 
 
@@ -77,8 +76,7 @@ class _Window:
     def _show_room(self) -> None:
         source, data = self.room.physics.data.ptr, self.shown.data.ptr
         with self.viewer.lock():
-            data.qpos[:], data.mocap_pos[:] = source.qpos, source.mocap_pos
-            mujoco.mj_forward(self.shown.model.ptr, data)
+            posed_as(self.shown.model.ptr, data, source.qpos, source.mocap_pos)
         self.viewer.sync()
 
 

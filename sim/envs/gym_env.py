@@ -29,6 +29,7 @@ from sim.envs.rendering import (
 from sim.envs.versions import STUDY_ITERATIONS
 from sim.envs.world import SEED_BOUND, checked_seed, event_dicts
 from sim.grasping.names import DEFAULT_GRASP
+from sim.movement import posed_as
 from sim.mujoco_import import mujoco
 from sim.task import ARM, VOICE
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
@@ -303,11 +304,7 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         pose = self._watcher.pose
         data = room.physics.data.ptr
         now = (data.qpos, data.mocap_pos, data.mocap_quat)
-        qpos, mocap_pos, mocap_quat = now if pose is None else pose
-        self._render_data.qpos[:] = qpos
-        self._render_data.mocap_pos[:] = mocap_pos
-        self._render_data.mocap_quat[:] = mocap_quat
-        mujoco.mj_forward(model, self._render_data)
+        posed_as(model, self._render_data, *(now if pose is None else pose))
         if isinstance(self._renderer, OffscreenRenderer):
             return self._renderer.render(self._render_data)
         assert self._renderer is not None
