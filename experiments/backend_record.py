@@ -48,17 +48,25 @@ def make_record(grasp: str, reach: float, capabilities: dict[str, bool]) -> dict
 
 
 def write_once(
-    trial_dir: str | os.PathLike, record: dict, recorded: manifest.Manifest | None
+    trial_dir: str | os.PathLike,
+    grasp: str,
+    reach: float,
+    capabilities: dict[str, bool],
+    recorded: manifest.Manifest | None,
+    unrecorded: list[Path],
 ) -> str | None:
-    """Write a trial's record unless it has one: the first run (or, for a trial written before
-    records, the first resume) records what its backend declares. One the trial's manifest
-    (`recorded`) holds but that is lost or damaged is written again when the backend still
-    declares exactly what was recorded (a line saying so is returned), and refused otherwise
-    (manifest.DamagedFileError, one line)."""
+    """Write a trial's record (`make_record`'s) unless it has one: the first run (or, for a
+    trial written before records, the first resume) records what its backend declares, and
+    appends its path to `unrecorded` (the files the next checkpoint's manifest records). One
+    the trial's manifest (`recorded`) holds but that is lost or damaged is written again when
+    the backend still declares exactly what was recorded (a line saying so is returned), and
+    refused otherwise (manifest.DamagedFileError, one line)."""
+    record = make_record(grasp, reach, capabilities)
     path = Path(trial_dir) / BACKEND_FILE
     if recorded is None or path not in recorded:
         if not path.exists():
             storage.write_json(path, record)
+        unrecorded.append(path)
         return None
     try:
         recorded.read_bytes(path, "")

@@ -58,8 +58,8 @@ from experiments.run import estimate, memory_segments, stop_requests
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.run.trial_checks import check_files
-from experiments.run.trial_files import TrialError, check_identity
+from experiments.run.trial_checks import check_files, check_identity
+from experiments.run.trial_files import TrialError
 from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 
 # How long a batch task waits for another writer of its trial to finish (s): longer than a

@@ -33,6 +33,11 @@ class DirectoryLock:
         self.path = self.directory / LOCK_FILE
         self._fd: int | None = None
 
+    @classmethod
+    def acquired(cls, directory: str | os.PathLike) -> DirectoryLock:
+        """The lock of `directory`, taken now (`acquire`, without waiting)."""
+        return cls(directory).acquire()
+
     def acquire(self, wait_s: float = 0.0) -> DirectoryLock:
         """Take the lock, waiting up to `wait_s` seconds for its holder to finish;
         DirectoryLocked if it is still held then."""

@@ -14,11 +14,10 @@ moved aside into `stale-at-NNNNNNNN/`.
 
 from __future__ import annotations
 
+import functools
 import os
 import time
 from collections.abc import Callable
-from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -28,34 +27,16 @@ from experiments import backend_record, manifest, provenance, storage
 from experiments.file_names import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
-    LOG_DIR,
-    LOG_README_FILE,
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path, source_of
+from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path
 from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
-from experiments.run import estimate, memory_segments, progress_bar, stop_requests
-from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.run import memory_segments, progress_bar, stop_requests
 from experiments.run.settings import TrialSettings, typed_config
-from experiments.run.trial_files import (
-    LOG_README,
-    WORDS_LOG_PERIOD,
-    TrialError,
-    TrialLocked,
-    created_as,
-    learner_values,
-    log_row,
-    trial_identity,
-    trial_parts,
-    trial_path,
-)
-from experiments.run.trial_opening import open_trial_directory, refuse_foreign_path
+from experiments.run.trial_files import WORDS_LOG_PERIOD, learner_values, log_row, trial_parts
+from experiments.run.trial_opening import open_trial_directory
 from models.layout import TOYS, block_slice
-
-if TYPE_CHECKING:
-    from learner.agent import Agent
-    from sim.playroom import Playroom
 
 _SOUND = block_slice("sound")
 _TOY_MOVED_BY = tuple(f"{toy}_moved_by" for toy in TOYS)
@@ -63,47 +44,48 @@ _TOY_MOVED_BY = tuple(f"{toy}_moved_by" for toy in TOYS)
 
 class Trial:
     """A trial directory and the loop that fills it. It holds the directory's lock from its
-    creation until `close` (or the end of the process)."""
+    creation until `close` (or the end of the process).
+
+    Its opening reads from top to bottom: the settings typed once, the room and agent built
+    from them (before anything is written: a config that makes no room or agent leaves the
+    directory as it was), the directory opened (experiments/run/trial_opening.py: checked,
+    locked, config.json written or compared, a resume's checkpoint restored into those parts),
+    who computes recorded (provenance.json), what the backend declares recorded
+    (backend.json)."""
 
     def __init__(self, out_dir: str | os.PathLike, settings: TrialSettings, resume: bool = False):
-        self.dir = trial_path(out_dir)
         self.settings = settings
         typed = typed_config(settings)  # the settings typed once, here
         self.config = typed.json
-        self.identity = trial_identity(self.config)  # carried by every checkpoint and log chunk
-        self.source = source_of(self.dir, self.config)  # first in every log row
-        self.notices: list[str] = []  # one line each: what a resume had to do
-        refuse_foreign_path(self.dir)
+        # Built before anything is written; a resume restores into them (and builds others if a
+        # restore fails half-way).
+        build = functools.partial(
+            trial_parts, settings.grasp, settings.seed, typed.world, typed.voice, typed.learner
+        )
+        parts = build()
+        opened = open_trial_directory(out_dir, settings, self.config, parts, build, resume)
+        self.dir, self._lock, self.notices = opened.dir, opened.lock, opened.notices
+        self.identity, self.source = opened.identity, opened.source
+        self.agent, self.room = opened.agent, opened.room
+        self.iteration = opened.iteration
+        words = len(self.room.vocal_tract.config.words)
+        self.best_word_distance = (
+            np.full(words, np.inf)
+            if opened.best_word_distance is None
+            else opened.best_word_distance
+        )
+        self.counts = opened.counts or {
+            "tool_uses": 0,
+            "words_recognised": 0,
+            "diverged": 0,
+            "stick_returns": 0,
+        }
+        self.memory = opened.memory  # what the memory's segments hold: each checkpoint the rest
+        self.manifest_pointer, self.recorded = opened.manifest_pointer, opened.recorded
+        self.unrecorded = opened.unrecorded
+        self.elapsed: float | None = None  # seconds of the last `run_trial`
+        self.start_iteration = self.iteration
         try:
-            self._lock = DirectoryLock(self.dir).acquire()
-        except DirectoryLocked as exc:
-            raise TrialLocked(str(exc)) from None
-        except OSError as exc:
-            raise TrialError(f"cannot write into {self.dir}: {exc.strerror}") from None
-        try:
-            # Built before anything is written: a config that makes no room or agent leaves
-            # the directory as it was.
-            self.agent, self.room = trial_parts(
-                settings.grasp, settings.seed, typed.world, typed.voice, typed.learner
-            )
-            restored = open_trial_directory(self.dir, self.config, resume, self.notices)
-            self.iteration = 0
-            self.best_word_distance = np.full(len(self.room.vocal_tract.config.words), np.inf)
-            self.counts = {"tool_uses": 0, "words_recognised": 0, "diverged": 0, "stick_returns": 0}
-            self.elapsed: float | None = None  # seconds of the last `run_trial`
-            self.start_iteration = 0
-            # What the memory's segments hold (none yet): each checkpoint writes the rest.
-            self.memory = memory_segments.MemoryOnDisk({}, None, 0)
-            # The newest manifest file (experiments/manifest.py), and the data files written
-            # since it, which the next checkpoint records.
-            self.manifest_pointer: dict | None = None
-            self.recorded: manifest.Manifest | None = None
-            self.unrecorded: list[Path] = []
-            if restored is not None:
-                self._continue_from(*restored)
-            readme = self.dir / LOG_DIR / LOG_README_FILE
-            if not readme.exists():  # a new trial's, or an old one's moved into the folders
-                storage.write_text(readme, LOG_README)
             if not self.finished:  # who computes from here on (provenance.json)
                 self.notices += provenance.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()
@@ -121,15 +103,18 @@ class Trial:
         """What the trial's backend declares, for analysis to read (backend.json): written once,
         or rewritten when lost or damaged if the backend declares what the trial recorded."""
         backend = self.room.backend
-        record = backend_record.make_record(backend.name, backend.reach(), backend.capabilities())
         if self.finished and not (self.dir / BACKEND_FILE).exists() and self.recorded is None:
             return  # a finished trial from before backend.json: read from its config instead
-        notice = backend_record.write_once(self.dir, record, self.recorded)
+        notice = backend_record.write_once(
+            self.dir,
+            backend.name,
+            backend.reach(),
+            backend.capabilities(),
+            self.recorded,
+            self.unrecorded,
+        )
         if notice is not None:
             self.notices.append(notice)
-        path = self.dir / BACKEND_FILE
-        if self.recorded is None or path not in self.recorded:
-            self.unrecorded.append(path)
 
     @property
     def finished(self) -> bool:
@@ -174,22 +159,6 @@ class Trial:
         storage.write_arrays(newest, arrays, meta)
         self.memory = memory
         self.manifest_pointer, self.unrecorded = pointer, []
-
-    def _continue_from(
-        self, agent: Agent, room: Playroom, meta: dict, recorded: manifest.Manifest | None
-    ) -> None:
-        """The trial as the checkpoint a resume restored left it (`open_trial_directory`)."""
-        self.agent, self.room, self.recorded = agent, room, recorded
-        self.iteration = int(meta["iteration"])
-        self.best_word_distance = np.asarray(meta["best_word_distance"], dtype=float)
-        self.counts = dict(meta["counts"])
-        self.memory = memory_segments.on_disk(meta)
-        self.source["trial"] = created_as(self.dir, meta, str(self.source["trial"]))
-        self.manifest_pointer = meta.get(manifest.MANIFEST_KEY)
-        if self.manifest_pointer is None:
-            # A trial written before manifests: its next checkpoint records every data file
-            # it holds, as checked by the resume, and it is checked from then on.
-            self.unrecorded = manifest.data_files(self.dir)
 
     # The loop -----------------------------------------------------------------------------
     def run(
@@ -300,11 +269,9 @@ def run_trial(
     """Create (or resume) a trial in out_dir and run it to the end. `notify` is called, before
     the run, with each line a resume has to report (a fallback checkpoint, an extension);
     `report` with the iteration reached, every `report_every` iterations and at the end.
-    A trial that will not fit on its disk is refused first (TrialError); a long one is told
-    to `notify`, first, with its expected time and disk (experiments/run/estimate.py)."""
-    line = estimate.check_fits(trial_path(out_dir), settings, resume)
-    if line is not None and notify is not None:
-        notify(line)
+    A trial that will not fit on its disk is refused before anything is written (TrialError);
+    a long one is told to `notify`, first, with its expected time and disk
+    (experiments/run/estimate.py)."""
     trial = Trial(out_dir, settings, resume=resume)
     if notify is not None:
         for notice in trial.notices:
@@ -312,7 +279,6 @@ def run_trial(
     try:
         if trial.finished:
             return trial
-        trial.start_iteration = trial.iteration
         start = time.perf_counter()
         trial.run(progress=progress, report=report, every=report_every)
         trial.elapsed = time.perf_counter() - start

@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 from experiments import manifest, storage
@@ -36,31 +37,84 @@ from experiments.log_layout import (
     check_chunk,
     chunk_path,
     chunk_paths,
+    identity_text,
     trial_identity,
 )
+from experiments.run import memory_segments
 from experiments.run.old_logs import move_old_chunks
-from experiments.run.trial_files import (
-    WORDS_LOG_PERIOD,
-    TrialError,
-    fresh_trial_parts,
-    restore_checkpoint,
-)
+from experiments.run.trial_files import WORDS_LOG_PERIOD, TrialError, fresh_trial_parts
 from learner.agent import Agent
 from sim import Playroom
 
 
+def check_identity(path: Path, meta: dict, config: dict) -> None:
+    """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
+    A checkpoint without identity (written before checkpoints carried one) is taken as the
+    trial's: the caller says so where it can."""
+    found, own = meta.get("identity"), trial_identity(config)
+    if found is None or found == own:
+        return
+    raise TrialError(
+        f"{path.name} belongs to another trial ({identity_text(found)}) than "
+        f"{path.parent} ({identity_text(own)}); refusing to mix them"
+    )
+
+
+def restore_checkpoint(
+    trial_dir: str | os.PathLike,
+    agent: Agent,
+    room: Playroom,
+    name: str = CHECKPOINT_FILE,
+    *,
+    config: dict,
+) -> dict:
+    """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`;
+    returns the checkpoint's metadata with 'best_word_distance' added. CorruptFileError if it
+    or a segment cannot be read or restored; TrialError if either belongs to another trial
+    than `config`'s."""
+    path = Path(trial_dir) / name
+    if not path.exists():
+        raise storage.CorruptFileError(f"{path} is missing")
+    arrays, meta = storage.read_arrays(path)
+    check_identity(path, meta, config)
+    try:
+        arrays = memory_segments.with_rows(path, arrays, meta)
+    except memory_segments.ForeignSegmentError as exc:
+        raise TrialError(str(exc)) from None
+    try:
+        prefix = memory_segments.AGENT
+        agent_state = {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
+        agent.load_state_dict(agent_state)
+        room.set_state({**meta["room"], "physics": arrays["room/physics"]})
+        meta["best_word_distance"] = arrays["best_word_distance"].copy()
+    except (KeyError, ValueError, TypeError) as exc:
+        raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
+    return meta
+
+
+# How a trial's agent and room at iteration 0 are built, new ones at each call.
+Build = Callable[[], tuple[Agent, Playroom]]
+
+
 def restore_newest(
-    trial_dir: str | os.PathLike, config: dict
+    trial_dir: str | os.PathLike,
+    config: dict,
+    first: tuple[Agent, Playroom] | None = None,
+    build: Build | None = None,
 ) -> tuple[Agent, Playroom, dict, str | None]:
-    """A trial's newest usable checkpoint, restored into fresh parts: (agent, room, meta,
-    fallback), `fallback` None when checkpoint.npz was used, else one line saying what is
-    wrong with it (missing, or damaged). TrialError if neither checkpoint can be used (naming
-    both, and what is wrong with each), or if the one read belongs to another trial."""
+    """A trial's newest usable checkpoint, restored into fresh parts (`first`, built already,
+    then `build`'s, by default those `config` makes): (agent, room, meta, fallback), `fallback`
+    None when checkpoint.npz was used, else one line saying what is wrong with it (missing, or
+    damaged). TrialError if neither checkpoint can be used (naming both, and what is wrong with
+    each), or if the one read belongs to another trial."""
     trial_dir = Path(trial_dir)
     problems = []
     for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
         # A restore that failed half-way may have changed them: each try starts afresh.
-        agent, room = fresh_trial_parts(config)
+        if first is not None:
+            (agent, room), first = first, None
+        else:
+            agent, room = fresh_trial_parts(config) if build is None else build()
         try:
             meta = restore_checkpoint(trial_dir, agent, room, name, config=config)
         except storage.CorruptFileError as exc:
@@ -268,14 +322,19 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
 Restored = tuple[Agent, Playroom, dict, manifest.Manifest | None]
 
 
-def prepare_resume(trial_dir: Path, config: dict, notices: list[str]) -> Restored | None:
+def prepare_resume(
+    trial_dir: Path, config: dict, parts: tuple[Agent, Playroom], build: Build, notices: list[str]
+) -> Restored | None:
     """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
-    checkpoint from before manifests) of the newest usable checkpoint whose logs are whole
-    and as recorded, or None to start from iteration 0 (no checkpoint and no
-    logs yet). Everything is checked before anything is changed; then a damaged newest
-    checkpoint is kept as checkpoint.damaged.npz and the litter of killed writers removed.
-    Appends to `notices` one line per thing done or noticed. TrialError if the trial cannot
-    be resumed (the message says why and what can be done)."""
+    checkpoint from before manifests) of the newest usable checkpoint, restored into `parts`
+    (fresh ones `build` builds where a restore fails half-way),
+    whose logs are whole and as recorded, or None to start from iteration 0 (no checkpoint and
+    no logs yet). Everything is checked before anything is changed; then a damaged newest
+    checkpoint is kept as checkpoint.damaged.npz, the litter of killed writers removed, old
+    logs moved into their folders and the work past the checkpoint (log chunks, memory
+    segments, manifest files) dropped: the run writes it again. Appends to `notices` one line
+    per thing done or noticed. TrialError if the trial cannot be resumed (the message says why
+    and what can be done)."""
     newest = trial_dir / CHECKPOINT_FILE
     if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
         # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
@@ -291,7 +350,7 @@ def prepare_resume(trial_dir: Path, config: dict, notices: list[str]) -> Restore
         notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
         restored = None
     else:
-        agent, room, meta, fallback = restore_newest(trial_dir, config)
+        agent, room, meta, fallback = restore_newest(trial_dir, config, parts, build)
         recorded = _recorded(trial_dir, meta)
         check_logs(trial_dir, int(meta["iteration"]), config, recorded)
         restored = agent, room, meta, recorded
@@ -320,13 +379,16 @@ def prepare_resume(trial_dir: Path, config: dict, notices: list[str]) -> Restore
             f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
             "log/words-*.parquet) into log/iterations/ and log/words/"
         )
+    _drop_work_past(trial_dir, 0 if restored is None else int(restored[2]["iteration"]))
     return restored
 
 
-def drop_logs_past(trial_dir: Path, iteration: int) -> None:
-    """Delete the log chunks that start at `iteration` or later: the work past a checkpoint,
-    which the resumed run rewrites."""
+def _drop_work_past(trial_dir: Path, iteration: int) -> None:
+    """Delete what was written past the checkpoint at `iteration` (the lost work's log chunks,
+    memory segments and manifest files), which the resumed run writes again."""
     for kind in LOG_KINDS:
         for start, chunk in _chunks(trial_dir, kind).items():
             if start >= iteration:
                 chunk.unlink()
+    memory_segments.drop_segments_past(trial_dir, iteration)
+    manifest.drop_past(trial_dir, iteration)

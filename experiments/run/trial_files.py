@@ -32,16 +32,9 @@ when it is whole (its checkpoint its own and readable, the logs it covers comple
 
 from __future__ import annotations
 
-import errno
-import os
-import shutil
-from pathlib import Path
-
 import numpy as np
 
-from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, STALE_PREFIX, TRIAL_ENTRIES
-from experiments.log_layout import chunk_paths, identity_text, trial_identity
+from experiments.file_names import CONFIG_FILE
 from experiments.log_schema import (
     CAREGIVER_SAID,
     DIVERGED,
@@ -56,7 +49,6 @@ from experiments.log_schema import (
     WORD_RECOGNISED,
     moved_by,
 )
-from experiments.run import memory_segments
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from models.layout import BLOCK_DIM, context_indices
@@ -144,25 +136,6 @@ def learner_values(
     )
 
 
-def trial_path(out_dir: str | os.PathLike) -> Path:
-    """`out_dir` as a Path, if it can name a directory; TrialError (one line) for a symbolic
-    link loop, which no directory can be made or found at."""
-    path = Path(out_dir)
-    try:
-        path.resolve()  # Python 3.11 raises RuntimeError on a loop
-        path.stat()  # later versions resolve it as it is: the system says ELOOP
-    except FileNotFoundError:  # a trial to be made: its folder is created by the run
-        pass
-    except (RuntimeError, OSError) as exc:
-        if isinstance(exc, RuntimeError) or exc.errno == errno.ELOOP:
-            raise TrialError(
-                f"{path} cannot be used: it is a symbolic link loop (a link that leads back to "
-                "itself); choose another directory"
-            ) from None
-        # Anything else (a parent that is a file, no permission) is said where it is used.
-    return path
-
-
 def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
     """The agent and room of a trial's iteration 0, as its config (config.json's form) makes
     them. TrialConfigError (one line) for a config that makes none: a config.json edited by
@@ -187,87 +160,3 @@ def trial_parts(
     room = Playroom(grasp=grasp, seed=seed, config=world, voice=voice)
     agent = Agent(learner, np.random.default_rng([seed, AGENT_STREAM]))
     return agent, room
-
-
-def created_as(trial_dir: Path, meta: dict, default: str) -> str:
-    """The name a trial was created as, which every row of its logs carries however its
-    directory is renamed or moved: its checkpoint's record of it, or for a checkpoint from
-    before that record, the `trial` of its first log row (`default` where neither is)."""
-    name = meta.get("trial_name")
-    if isinstance(name, str):
-        return name
-    first = chunk_paths(trial_dir, "iterations")
-    if first:
-        try:
-            rows = storage.read_table(next(iter(first.values())), ["trial"])
-        except storage.CorruptFileError:
-            return default  # the resume's checks name the damage
-        if "trial" in rows and len(rows):
-            return str(rows["trial"].iloc[0])
-    return default
-
-
-def move_derived_aside(trial_dir: Path, iteration: int) -> str | None:
-    """Move what was derived from a trial at `iteration` (its evaluation, timing, videos) into
-    `stale-at-<iteration>/`, before the trial is extended; what was moved, in words, or None."""
-    stale = trial_dir / f"{STALE_PREFIX}{iteration:08d}"
-    # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a writer
-    # (one `remove_litter` spared): none is a result derived from the trial.
-    derived = [
-        p
-        for p in trial_dir.iterdir()
-        if p.name not in TRIAL_ENTRIES
-        and not p.name.startswith(STALE_PREFIX)
-        and storage.temporary_writer(p.name) is None
-    ]
-    if not derived:
-        return None
-    stale.mkdir(exist_ok=True)
-    for path in derived:
-        shutil.move(path, stale / path.name)
-    return f"the shorter run's {', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"
-
-
-def check_identity(path: Path, meta: dict, config: dict) -> None:
-    """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
-    A checkpoint without identity (written before checkpoints carried one) is taken as the
-    trial's: the caller says so where it can."""
-    found, own = meta.get("identity"), trial_identity(config)
-    if found is None or found == own:
-        return
-    raise TrialError(
-        f"{path.name} belongs to another trial ({identity_text(found)}) than "
-        f"{path.parent} ({identity_text(own)}); refusing to mix them"
-    )
-
-
-def restore_checkpoint(
-    trial_dir: str | os.PathLike,
-    agent: Agent,
-    room: Playroom,
-    name: str = CHECKPOINT_FILE,
-    *,
-    config: dict,
-) -> dict:
-    """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`;
-    returns the checkpoint's metadata with 'best_word_distance' added. CorruptFileError if it
-    or a segment cannot be read or restored; TrialError if either belongs to another trial
-    than `config`'s."""
-    path = Path(trial_dir) / name
-    if not path.exists():
-        raise storage.CorruptFileError(f"{path} is missing")
-    arrays, meta = storage.read_arrays(path)
-    check_identity(path, meta, config)
-    try:
-        arrays = memory_segments.with_rows(path, arrays, meta)
-    except memory_segments.ForeignSegmentError as exc:
-        raise TrialError(str(exc)) from None
-    try:
-        prefix = memory_segments.AGENT
-        agent_state = {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
-        agent.load_state_dict(agent_state)
-        room.set_state({**meta["room"], "physics": arrays["room/physics"]})
-        meta["best_word_distance"] = arrays["best_word_distance"].copy()
-    except (KeyError, ValueError, TypeError) as exc:
-        raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
-    return meta

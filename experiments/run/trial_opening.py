@@ -1,33 +1,163 @@
 """A trial directory opened for a run, started or resumed, decided here in one place and read
-from top to bottom (`open_trial_directory`): a directory of something else is refused, a
-trial's is refused without `resume` and with another configuration, a new trial's config.json
-is written, and a resumed trial's newest usable checkpoint is restored (its logs checked
-first: experiments/run/trial_checks.py), the work past it dropped, and the trial extended if
-more iterations are asked for. Called by `Trial` (experiments/run/trial.py) under the
-directory's lock, once the trial's room and agent have been built from the config (a config
-that builds none leaves the directory as it was)."""
+from top to bottom (`open_trial_directory`): the path and the disk checked, a directory of
+something else refused, the directory locked, a trial's refused without `resume` and with
+another configuration, a new trial's config.json written, and a resumed trial's newest usable
+checkpoint restored (its logs checked first and the work past it dropped:
+experiments/run/trial_checks.py) and the trial extended if more iterations are asked for.
+What the run starts from comes back whole (`OpenedTrial`): `Trial` (experiments/run/trial.py)
+only takes it. Called once the trial's room and agent have been built from its typed settings
+(a config that builds none leaves the directory as it was); config.json is read once here."""
 
 from __future__ import annotations
 
 import contextlib
+import errno
+import os
+import shutil
+from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from experiments import manifest, storage
 from experiments.config_file import UnknownSettingError, check_known, with_added_settings
-from experiments.file_names import CONFIG_FILE, LOCK_FILE, LOG_DIR
-from experiments.log_layout import EXTENSIBLE
-from experiments.run import memory_segments
-from experiments.run.trial_checks import (
-    Restored,
-    drop_logs_past,
-    is_litter,
-    prepare_resume,
-    remove_litter,
+from experiments.file_names import (
+    CONFIG_FILE,
+    LOCK_FILE,
+    LOG_DIR,
+    LOG_README_FILE,
+    STALE_PREFIX,
+    TRIAL_ENTRIES,
 )
-from experiments.run.trial_files import TrialError, move_derived_aside
+from experiments.log_layout import EXTENSIBLE, chunk_paths, source_of, trial_identity
+from experiments.run import estimate, memory_segments
+from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_checks import Build, is_litter, prepare_resume, remove_litter
+from experiments.run.trial_files import LOG_README, TrialError, TrialLocked
+from learner.agent import Agent
+from sim import Playroom
 
 
-def refuse_foreign_path(d: Path) -> None:
+@dataclass
+class OpenedTrial:
+    """A trial directory ready for its run, locked (`lock`), and what the run starts from:
+    the agent and room (restored, or at iteration 0), where the checkpoint left the trial, the
+    files its next checkpoint records, and one line per thing the opening did or noticed."""
+
+    dir: Path
+    lock: DirectoryLock
+    identity: dict  # carried by every checkpoint and log chunk
+    source: dict  # first in every log row
+    agent: Agent
+    room: Playroom
+    iteration: int = 0
+    best_word_distance: np.ndarray | None = None  # None: none reached yet
+    counts: dict | None = None  # None: all zero
+    memory: memory_segments.MemoryOnDisk = field(
+        default_factory=lambda: memory_segments.MemoryOnDisk({}, None, 0)
+    )
+    # The newest manifest file (experiments/manifest.py), the manifest of the checkpoint
+    # restored, and the data files written since it, which the next checkpoint records.
+    manifest_pointer: dict | None = None
+    recorded: manifest.Manifest | None = None
+    unrecorded: list[Path] = field(default_factory=list)
+    notices: list[str] = field(default_factory=list)
+
+
+def open_trial_directory(
+    out_dir: str | os.PathLike,
+    settings: TrialSettings,
+    config: dict,
+    parts: tuple[Agent, Playroom],
+    build: Build,
+    resume: bool,
+) -> OpenedTrial:
+    """The directory made ready for the run of `settings` (`config`, its config.json form;
+    `parts`, the agent and room built from them at iteration 0: the run's, or those a resume
+    restores into; `build` builds others if a restore fails half-way). TrialError (one line)
+    if the directory cannot be used; the lock is held only if the opening succeeds."""
+    d = trial_path(out_dir)
+    notices = []
+    line = estimate.check_fits(d, settings, resume)  # before anything is written
+    if line is not None:
+        notices.append(line)
+    _refuse_foreign_path(d)
+    try:
+        lock = DirectoryLock.acquired(d)
+    except DirectoryLocked as exc:
+        raise TrialLocked(str(exc)) from None
+    except OSError as exc:
+        raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
+    try:
+        opened = _opened(d, lock, config, parts, build, resume)
+    except BaseException:
+        lock.release()
+        raise
+    opened.notices[:0] = notices
+    return opened
+
+
+def _opened(
+    d: Path,
+    lock: DirectoryLock,
+    config: dict,
+    parts: tuple[Agent, Playroom],
+    build: Build,
+    resume: bool,
+) -> OpenedTrial:
+    config_path = d / CONFIG_FILE
+    held = None
+    if config_path.exists():
+        if not resume:
+            raise TrialError(
+                f"{d} already holds a trial; add --resume to continue it, or choose a new directory"
+            )
+        held = storage.read_json(config_path)
+        _check_same_configuration(config_path, held, config)
+    try:
+        (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
+        storage.check_writable(d)
+    except OSError as exc:
+        raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
+    if held is None:
+        _write_first_config(d, config)
+    identity, source = trial_identity(config), source_of(d, config)
+    notices: list[str] = []
+    restored = prepare_resume(d, config, parts, build, notices) if resume else None
+    if restored is None:
+        agent, room = parts
+        opened = OpenedTrial(d, lock, identity, source, agent, room, notices=notices)
+    else:
+        agent, room, meta, recorded = restored
+        opened = OpenedTrial(
+            d,
+            lock,
+            identity,
+            {**source, "trial": created_as(d, meta, str(source["trial"]))},
+            agent,
+            room,
+            iteration=int(meta["iteration"]),
+            best_word_distance=np.asarray(meta["best_word_distance"], dtype=float),
+            counts=dict(meta["counts"]),
+            memory=memory_segments.on_disk(meta),
+            manifest_pointer=meta.get(manifest.MANIFEST_KEY),
+            recorded=recorded,
+            notices=notices,
+        )
+        if opened.manifest_pointer is None:
+            # A trial written before manifests: its next checkpoint records every data file
+            # it holds, as checked by the resume, and it is checked from then on.
+            opened.unrecorded = manifest.data_files(d)
+        if held is not None:
+            _extend_if_asked(d, held, config, opened.iteration, notices)
+    readme = d / LOG_DIR / LOG_README_FILE
+    if not readme.exists():  # a new trial's, or an old one's moved into the folders
+        storage.write_text(readme, LOG_README)
+    return opened
+
+
+def _refuse_foreign_path(d: Path) -> None:
     """Before anything is written: a file, or a folder of something else, is refused (a
     folder of a new trial killed while writing its first file holds the lock and that
     file's temporary: it is the same command's to use again)."""
@@ -38,43 +168,10 @@ def refuse_foreign_path(d: Path) -> None:
             raise TrialError(f"{d} is not empty and holds no trial; choose an empty directory")
 
 
-def open_trial_directory(
-    d: Path, config: dict, resume: bool, notices: list[str]
-) -> Restored | None:
-    """The directory made ready for the run of `config` (the module's docstring). Returns what
-    a resume starts from (`prepare_resume`'s), or None to start from iteration 0. Appends to
-    `notices` one line per thing a resume did or noticed; TrialError (one line) if the
-    directory cannot be used."""
-    config_path = d / CONFIG_FILE
-    if config_path.exists():
-        if not resume:
-            raise TrialError(
-                f"{d} already holds a trial; add --resume to continue it, or choose a new directory"
-            )
-        _check_same_configuration(config_path, config)
-    try:
-        (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
-        storage.check_writable(d)
-    except OSError as exc:
-        raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
-    if not config_path.exists():
-        _write_first_config(d, config)
-    if not resume:
-        return None
-    restored = prepare_resume(d, config, notices)
-    iteration = 0 if restored is None else int(restored[2]["iteration"])
-    # The lost work's, past the checkpoint: rewritten by the run.
-    drop_logs_past(d, iteration)
-    memory_segments.drop_segments_past(d, iteration)
-    manifest.drop_past(d, iteration)
-    _extend_if_asked(d, config, iteration, notices)
-    return restored
-
-
-def _check_same_configuration(config_path: Path, config: dict) -> None:
-    """A resumed trial's config.json holds the same settings as the run's (but those a resume
-    may extend)."""
-    held = with_added_settings(storage.read_json(config_path))
+def _check_same_configuration(config_path: Path, held: dict, config: dict) -> None:
+    """A resumed trial's config.json (`held`) holds the same settings as the run's (but those
+    a resume may extend)."""
+    held = with_added_settings(held)
     try:
         check_known(held, config_path)
     except UnknownSettingError as exc:
@@ -93,7 +190,7 @@ def _check_same_configuration(config_path: Path, config: dict) -> None:
 
 def _write_first_config(d: Path, config: dict) -> None:
     """A new trial's config.json, its first file."""
-    remove_litter(d)  # under the lock: a killed first write's (`refuse_foreign_path`)
+    remove_litter(d)  # under the lock: a killed first write's (`_refuse_foreign_path`)
     try:
         storage.write_json(d / CONFIG_FILE, config)
     except OSError:
@@ -104,11 +201,11 @@ def _write_first_config(d: Path, config: dict) -> None:
         raise
 
 
-def _extend_if_asked(d: Path, config: dict, iteration: int, notices: list[str]) -> None:
-    """More iterations asked than the trial was run with: config.json says so, and what was
-    derived from the shorter run is moved aside."""
-    config_path = d / CONFIG_FILE
-    stored = storage.read_json(config_path)
+def _extend_if_asked(
+    d: Path, stored: dict, config: dict, iteration: int, notices: list[str]
+) -> None:
+    """More iterations asked than the trial (config.json: `stored`) was run with: config.json
+    says so, and what was derived from the shorter run is moved aside."""
     asked, stored_total = config["trial"]["iterations"], stored["trial"]["iterations"]
     if asked == stored_total:
         return
@@ -119,4 +216,62 @@ def _extend_if_asked(d: Path, config: dict, iteration: int, notices: list[str]) 
     moved = move_derived_aside(d, iteration)
     if moved:
         notices.append(f"extended from {stored_total} to {asked} iterations; {moved}")
-    storage.write_json(config_path, config)
+    storage.write_json(d / CONFIG_FILE, config)
+
+
+def trial_path(out_dir: str | os.PathLike) -> Path:
+    """`out_dir` as a Path, if it can name a directory; TrialError (one line) for a symbolic
+    link loop, which no directory can be made or found at."""
+    path = Path(out_dir)
+    try:
+        path.resolve()  # Python 3.11 raises RuntimeError on a loop
+        path.stat()  # later versions resolve it as it is: the system says ELOOP
+    except FileNotFoundError:  # a trial to be made: its folder is created by the run
+        pass
+    except (RuntimeError, OSError) as exc:
+        if isinstance(exc, RuntimeError) or exc.errno == errno.ELOOP:
+            raise TrialError(
+                f"{path} cannot be used: it is a symbolic link loop (a link that leads back to "
+                "itself); choose another directory"
+            ) from None
+        # Anything else (a parent that is a file, no permission) is said where it is used.
+    return path
+
+
+def created_as(trial_dir: Path, meta: dict, default: str) -> str:
+    """The name a trial was created as, which every row of its logs carries however its
+    directory is renamed or moved: its checkpoint's record of it, or for a checkpoint from
+    before that record, the `trial` of its first log row (`default` where neither is)."""
+    name = meta.get("trial_name")
+    if isinstance(name, str):
+        return name
+    first = chunk_paths(trial_dir, "iterations")
+    if first:
+        try:
+            rows = storage.read_table(next(iter(first.values())), ["trial"])
+        except storage.CorruptFileError:
+            return default  # the resume's checks name the damage
+        if "trial" in rows and len(rows):
+            return str(rows["trial"].iloc[0])
+    return default
+
+
+def move_derived_aside(trial_dir: Path, iteration: int) -> str | None:
+    """Move what was derived from a trial at `iteration` (its evaluation, timing, videos) into
+    `stale-at-<iteration>/`, before the trial is extended; what was moved, in words, or None."""
+    stale = trial_dir / f"{STALE_PREFIX}{iteration:08d}"
+    # Neither the trial's own files, nor earlier stale ones, nor a temporary file of a writer
+    # (one `remove_litter` spared): none is a result derived from the trial.
+    derived = [
+        p
+        for p in trial_dir.iterdir()
+        if p.name not in TRIAL_ENTRIES
+        and not p.name.startswith(STALE_PREFIX)
+        and storage.temporary_writer(p.name) is None
+    ]
+    if not derived:
+        return None
+    stale.mkdir(exist_ok=True)
+    for path in derived:
+        shutil.move(path, stale / path.name)
+    return f"the shorter run's {', '.join(sorted(p.name for p in derived))} moved to {stale.name}/"

@@ -19,10 +19,9 @@ from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.batches.runner import is_complete
 from experiments.cli.main import main
 from experiments.file_names import CONFIG_FILE, LOCK_FILE, LOG_DIR, LOG_KINDS
-from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_identity
+from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_identity, trial_identity
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.run.trial_files import trial_identity
 
 TOTAL, PERIOD = 300, 100
 OWN, OTHER = 5, 6  # the seeds

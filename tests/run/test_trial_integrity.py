@@ -131,7 +131,7 @@ def test_killed_between_the_first_log_chunk_and_its_checkpoint_resumes_to_the_sa
 
 # 2. A checkpoint carries its trial's identity ------------------------------------------------
 def test_the_identity_is_the_seed_and_the_settings_that_make_the_trial():
-    from experiments.run.trial_files import trial_identity
+    from experiments.log_layout import trial_identity
 
     config = {
         "trial": {"seed": 3, "iterations": 10, "grasp": "kinematic"},
@@ -163,7 +163,7 @@ def test_a_checkpoint_of_another_trial_is_refused(base, tmp_path, capsys, settin
 
 
 def test_a_checkpoint_without_identity_is_taken_with_a_notice(base, tmp_path):
-    from experiments.run.trial_files import trial_identity
+    from experiments.log_layout import trial_identity
 
     out = _copy(base, tmp_path)
     arrays, meta = storage.read_arrays(out / CHECKPOINT_FILE)

@@ -1,0 +1,95 @@
+"""A trial's opening reads from top to bottom (experiments/run/trial.py, trial_opening.py): the
+trial calls each of its stages once, in order, and no module of experiments is called back by
+one it called, for a new trial and for a resume. Followed with a profiler over the calls
+between modules, from the trial's creation to its first iteration."""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+import experiments
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import Trial, run_trial
+
+ROOT = Path(experiments.__file__).resolve().parent
+# The trial's stages, in the order it calls them.
+STAGES = [
+    "run.settings",
+    "run.trial_files",
+    "run.trial_opening",
+    "provenance",
+    "backend_record",
+]
+
+
+def _module(filename: str) -> str | None:
+    try:
+        return ".".join(Path(filename).resolve().relative_to(ROOT).with_suffix("").parts)
+    except ValueError:
+        return None
+
+
+def _calls(make_trial) -> tuple[list[str], Counter]:
+    """The modules of experiments that run.trial calls, in order (a call of the same module
+    again counted again), and every call between two modules of experiments (caller, callee)."""
+    stack: list[str | None] = []
+    edges: Counter = Counter()
+    from_trial: list[str] = []
+    names: dict[str, str | None] = {}
+
+    def profile(frame, event, arg):
+        if event == "call":
+            filename = frame.f_code.co_filename
+            module = names.setdefault(filename, _module(filename))
+            caller = next((m for m in reversed(stack) if m), None)
+            if module and caller and caller != module:
+                edges[caller, module] += 1
+                if caller == "run.trial" and module not in stack:
+                    from_trial.append(module)
+            stack.append(module)
+        elif event == "return" and stack:
+            stack.pop()
+
+    sys.setprofile(profile)
+    try:
+        trial = make_trial()
+    finally:
+        sys.setprofile(None)
+    trial.close()
+    return from_trial, edges
+
+
+def _cycle(edges: Counter) -> list[str] | None:
+    """A module reached again from itself through the calls, or None."""
+    graph: dict[str, set[str]] = {}
+    for caller, callee in edges:
+        graph.setdefault(caller, set()).add(callee)
+
+    def walk(node: str, path: list[str]) -> list[str] | None:
+        for nxt in sorted(graph.get(node, ())):
+            if nxt in path:
+                return [*path[path.index(nxt) :], nxt]
+            found = walk(nxt, [*path, nxt])
+            if found:
+                return found
+        return None
+
+    return next((c for n in sorted(graph) if (c := walk(n, [n]))), None)
+
+
+@pytest.mark.parametrize("resume", [False, True])
+def test_a_trial_opens_top_to_bottom(tmp_path, resume):
+    settings = TrialSettings(iterations=20, seed=1, checkpoint_every=10)
+    out = tmp_path / "trial"
+    if resume:  # a trial with checkpoints and logs, extended
+        run_trial(out, settings, progress=False)
+        settings = TrialSettings(iterations=40, seed=1, checkpoint_every=10)
+    from_trial, edges = _calls(lambda: Trial(out, settings, resume=resume))
+    assert from_trial == STAGES
+    assert _cycle(edges) is None
+    # The opening checks a resumed trial's files once, top to bottom.
+    assert edges["run.trial_opening", "run.trial_checks"] == 1
