@@ -21,7 +21,7 @@ import numpy as np
 from models.layout import N_STEPS, TOYS
 from sim import events as ev
 from sim.config import WorldConfig
-from sim.grasping.base import GraspBackend
+from sim.grasping.carrying import Carrying
 from sim.movement import Brought, Holds
 from sim.physics import PlayroomPhysics
 from sim.vocal.config import VoiceConfig
@@ -68,12 +68,12 @@ class Caregiver:
 
     def __init__(
         self,
-        backend: GraspBackend,
+        carrying: Carrying,
         config: WorldConfig,
         vocal_tract: Voice,
         rng: np.random.Generator,
     ) -> None:
-        self.carrying = backend.carrying  # how she carries a toy in this world
+        self.carrying = carrying  # how she carries a toy in this world (her backend's part)
         self.config = config
         self.vocal_tract = vocal_tract
         self.words: WordAssignment = assign_words(rng, vocal_tract.config)

@@ -19,6 +19,7 @@ from sim.commands import checked_array, checked_command
 from sim.config import WorldConfig, world_preset
 from sim.dmp import arm_trajectory, voice_trajectory
 from sim.experimenter import Experimenter
+from sim.grasping.base import GraspBackend
 from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import load as backend_class
 from sim.model_edits import ModelEdits
@@ -70,8 +71,8 @@ class Playroom:
         self.rng = np.random.default_rng(self.seed)
         self.vocal_tract = make_tract(config.voice, exact_voice, voice, config)
         self.physics: PlayroomPhysics = backend.physics_class.load(config)
-        self.backend = backend(config, ModelEdits(self.physics))
-        self.caregiver = Caregiver(self.backend, config, self.vocal_tract, self.rng)
+        self.backend = compose_backend(backend, config, self.physics)
+        self.caregiver = Caregiver(self.backend.carrying, config, self.vocal_tract, self.rng)
         self.task = PlayroomTask(self.vocal_tract)
         self.experimenter = Experimenter(config, self.physics, self.backend)
         with self.physics.reset_context():  # as dm_control's Environment.reset starts one
@@ -276,3 +277,16 @@ class Playroom:
 
 
 __all__ = ["Feedback", "Playroom"]
+
+
+def compose_backend(
+    backend: type[GraspBackend], config: WorldConfig, physics: PlayroomPhysics
+) -> GraspBackend:
+    """A backend of the room, made of the parts it declares (sim/grasping/base.py), built here
+    on the room's physics (loaded as the backend's `physics_class`): the caregiver's carrying,
+    and the grasp rule where it is a part of its own; all edit the model through one
+    ModelEdits."""
+    edits = ModelEdits(physics)
+    carrying = backend.carrying_class(edits)
+    rule = None if backend.rule_class is None else backend.rule_class(config, edits, backend.name)
+    return backend(config, edits, carrying, rule)

@@ -1,8 +1,12 @@
 """What every grasp backend offers the room: the interface, and what the backends share.
 
 A backend decides how the world moves: what the arm does with its joint targets, what the hand
-and the stick's tip take, and when the stick has left the hand's reach; how the caregiver
-carries a toy she brings is a part of its own (`carrying`, sim/grasping/carrying.py). It
+and the stick's tip take, and when the stick has left the hand's reach. It is made of parts,
+which it declares and the playroom builds and hands it (sim/playroom.py, `compose_backend`):
+the physics it moves (`physics_class`), how the caregiver carries a toy she brings
+(`carrying_class`, sim/grasping/carrying.py) and, where the grasp rule is a part of its own, the
+rule (`rule_class`: the physical backend's contact rule, sim/grasping/contact_rule.py; the
+kinematic rules are computed with their geometry in one compiled kernel). It
 computes a whole movement one way (`simulate`), returning what it did and, when asked, its
 trace (sim/movement.py); `release(physics)` ends a movement: everything held is dropped where
 it is and the arm goes back to rest. The step-by-step Python forms of the backends' rules, the
@@ -12,13 +16,15 @@ oracle they are held to bit for bit, are in tests/stepped_oracle.py.
 from __future__ import annotations
 
 import abc
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from sim import events as ev
 from sim.config import WorldConfig
-from sim.grasping.carrying import Carrying
+from sim.grasping.carrying import Carrying, PlacedCarrying
 from sim.model_edits import ModelEdits
 from sim.movement import NOTHING_HELD, Holds, Movement, MovementOutcome, MovementTrace
 from sim.physics import PlayroomPhysics
@@ -37,15 +43,22 @@ class GraspBackend(abc.ABC):
     """
 
     name: str
-    physics_class: type[PlayroomPhysics] = PlayroomPhysics
     solid: bool
     closed_form: bool
-    # How the caregiver carries a toy she brings in this world (sim/grasping/carrying.py).
-    carrying: Carrying
+    # Its parts, declared here and built by the playroom (the module's docstring): each is
+    # built with the world's config and the model's edits, the rule also with the backend's
+    # name (under which it edits the model).
+    physics_class: type[PlayroomPhysics] = PlayroomPhysics
+    carrying_class: Callable[[ModelEdits], Carrying] = PlacedCarrying
+    rule_class: Callable[[WorldConfig, ModelEdits, str], Any] | None = None
 
-    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
+    def __init__(
+        self, config: WorldConfig, edits: ModelEdits, carrying: Carrying, rule: Any = None
+    ) -> None:
         self.config = config
         self.edits = edits  # run-time model changes, under the backend's name
+        self.carrying = carrying  # how the caregiver carries a toy she brings in this world
+        self.rule = rule  # the grasp rule, where it is a part of its own (else None)
         self.hand_holds: str | None = None  # "stick", "toy1", ... or None
         self.stick_holds: int | None = None  # index of the toy on the stick's tip
 

@@ -41,6 +41,9 @@ class Carrying(Protocol):
 class PlacedCarrying:
     """The toy itself is placed at every step of her path, as in the study."""
 
+    def __init__(self, edits: ModelEdits | None = None) -> None:
+        """Built as every carrying is (sim/grasping/base.py); it edits nothing of the model."""
+
     def takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
         """Nothing to take: the path starts where the toy lies."""
         return physics.object_poses()[1 + toy, :2]

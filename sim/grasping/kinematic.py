@@ -23,7 +23,7 @@ from sim import events as ev
 from sim.arm_servo import ArmServo
 from sim.config import WorldConfig
 from sim.grasping.base import ArmMovement, GraspBackend
-from sim.grasping.carrying import PlacedCarrying
+from sim.grasping.carrying import Carrying, PlacedCarrying
 from sim.kinematics import hand_positions
 from sim.model_edits import ModelEdits
 from sim.movement import (
@@ -87,9 +87,12 @@ class KinematicGrasp(GraspBackend):
     solid = False
     closed_form = True
 
-    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
-        super().__init__(config, edits)
-        self.carrying = PlacedCarrying()
+    carrying_class = PlacedCarrying
+
+    def __init__(
+        self, config: WorldConfig, edits: ModelEdits, carrying: Carrying, rule: None = None
+    ) -> None:
+        super().__init__(config, edits, carrying, rule)
         # The servo-driven arm under arm_dynamics "servo"; None: the arm is set to its targets.
         self._servo = ArmServo() if config.arm_dynamics == "servo" else None
 

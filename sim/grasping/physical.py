@@ -1,9 +1,10 @@
 """Grasping through MuJoCo contacts (docs/protocol.md §11 D16), the physical backend: position
 servos track the arm's targets through the dynamics, every object a solid body pushed by
 whatever touches it; a movement's control steps run compiled (sim/compiled_steps.py), returning
-here when a contact its grasp rule acts on appears. Its parts: the grasp rule
-(sim/grasping/contact_rule.py: what a touch takes, held by welds) and the caregiver's carrying
-(sim/grasping/carrying.py: her hand welded to the toy, lifted above the table).
+here when a contact its grasp rule acts on appears. Its parts, which the playroom
+builds and hands it: the grasp rule (sim/grasping/contact_rule.py: what a touch takes, held by
+welds) and the caregiver's carrying (sim/grasping/carrying.py: her hand welded to the toy,
+lifted above the table).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from sim import events as ev
 from sim.compiled_steps import AVAILABLE, MISSING
 from sim.config import SETTLE_PHYSICS_STEPS, WorldConfig
 from sim.grasping.base import GraspBackend, arm_to_rest
-from sim.grasping.carrying import WeldedCarrying
+from sim.grasping.carrying import Carrying, WeldedCarrying
 from sim.grasping.contact_rule import WATCHED_BY_NOTHING, ContactRule
 from sim.kinematics import segment_distance
 from sim.model_edits import ModelEdits
@@ -31,15 +32,18 @@ class PhysicalGrasp(GraspBackend):
 
     name = "physical"
     physics_class = PlayroomPhysics
+    carrying_class = WeldedCarrying
+    rule_class = ContactRule
     solid = True
     closed_form = False
+    rule: ContactRule
 
-    def __init__(self, config: WorldConfig, edits: ModelEdits) -> None:
+    def __init__(
+        self, config: WorldConfig, edits: ModelEdits, carrying: Carrying, rule: ContactRule
+    ) -> None:
         if not AVAILABLE:
             raise RuntimeError(MISSING)
-        super().__init__(config, edits)
-        self.rule = ContactRule(config, edits, self.name)
-        self.carrying = WeldedCarrying(edits)
+        super().__init__(config, edits, carrying, rule)
         self._before: np.ndarray | None = None  # the state `begin` saved
 
     def begin(self, physics: PlayroomPhysics) -> None:

@@ -9,7 +9,8 @@ module fails to import breaks only itself. The vocal tracts' registry has the sa
 (models/tracts.py, sim/vocal/registry.py).
 
 Adding a backend: its module (a `sim.grasping.base.GraspBackend` subclass whose `name` is its
-key here) and one line below; tests/sim/test_backend_contract.py then runs it.
+key here, declaring its parts, which the playroom builds: its physics, the caregiver's carrying,
+its grasp rule) and one line below; tests/sim/test_backend_contract.py then runs it.
 """
 
 from __future__ import annotations

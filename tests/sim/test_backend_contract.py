@@ -53,10 +53,9 @@ class DoubledGrasp(KinematicGrasp):
 
     name = DOUBLED
 
-    def __init__(self, config, edits):
-        super().__init__(
-            dataclasses.replace(config, grasp_distance=2 * config.grasp_distance), edits
-        )
+    def __init__(self, config, edits, carrying, rule=None):
+        doubled = dataclasses.replace(config, grasp_distance=2 * config.grasp_distance)
+        super().__init__(doubled, edits, carrying, rule)
 
 
 @pytest.fixture(scope="module", params=[*REGISTRY, DOUBLED])

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
+import numpy as np
 import pytest
 
 from experiments.batches.spec import BatchSpec
@@ -103,3 +104,27 @@ def test_a_third_backend_is_its_module_and_one_registry_line(monkeypatch, tmp_pa
     assert estimate.trial_costs(settings).seconds > 0
     # Its own rule: the hand takes what lies within twice the study's distance.
     assert trial.room.backend.config.grasp_distance == 2 * trial.room.config.grasp_distance
+
+
+def test_the_playroom_builds_the_parts_a_backend_declares(monkeypatch):
+    """A backend declaring another grasp rule (tests/third_backend.py) gets it from the room,
+    which hands the caregiver the backend's carrying: the same random arm movements that grasp
+    in the physical backend grasp nothing under a rule that takes nothing."""
+    from third_backend import TakesNothing
+
+    from sim import Playroom
+    from sim import events as ev
+    from sim.grasping.carrying import WeldedCarrying
+    from sim.grasping.registry import REGISTRY
+
+    monkeypatch.setitem(REGISTRY, "touchless", "third_backend:TouchlessGrasp")
+    commands = np.random.default_rng(0).uniform(-1, 1, (20, 21))
+    taken = {}
+    for grasp in ("physical", "touchless"):
+        room = Playroom(grasp, seed=3)
+        assert room.caregiver.carrying is room.backend.carrying
+        assert isinstance(room.backend.carrying, WeldedCarrying)
+        kinds = [e.kind for m in commands for e in room.act("arm", m).events]
+        taken[grasp] = sum(k in (ev.STICK_GRASPED, ev.TOY_GRASPED, ev.TOY_CAUGHT) for k in kinds)
+    assert isinstance(room.backend.rule, TakesNothing)
+    assert taken["physical"] > 0 and taken["touchless"] == 0
