@@ -106,10 +106,10 @@ class BaselineSettings:
 
 
 def trial_config(settings: BaselineSettings) -> dict:
-    """The trial's config.json (experiments/run/settings.py `full_config`): the world, voice and
+    """The trial's config.json (experiments/run/trial_config.py `full_config`): the world, voice and
     learner settings the baseline's room is built from. BaselineError for settings that make
     none (a DIVA voice whose data is not installed)."""
-    from experiments.run.settings import full_config
+    from experiments.run.trial_config import full_config
     from experiments.run.trial_files import TrialError
 
     try:

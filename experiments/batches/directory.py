@@ -18,7 +18,7 @@ from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.config_file import with_added_settings
 from experiments.file_names import BATCH_FILE, CONFIG_FILE, EVAL_FILE
 from experiments.log_layout import is_trial_dir
-from experiments.run.settings import full_config
+from experiments.run.trial_config import full_config
 
 # Fields compared as sets: their order changes only the order trials are listed in.
 _SETS = ("grasps", "babbling", "seeds")

@@ -17,7 +17,8 @@ from experiments import storage
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.batches.stored import stored_profiles
 from experiments.eval_worlds import EVAL_WORLDS
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_config import full_config
 from experiments.run.trial_files import TrialError
 from learner.config import BABBLING_MODES, LearnerConfig
 from models.checks import MAX_SEED

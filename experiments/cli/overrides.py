@@ -3,7 +3,7 @@ command line (`playroom run`, `batch`, `random`), as a batch config's "overrides
 
 The value is read as JSON when it is JSON (0.05, true, [1, 2], "text"), else taken as a string
 (`--set world.stick_return=never` needs no quotes). Only the form is checked here: the names
-and values are checked by the configs, as every override is (experiments/run/settings.py)."""
+and values are checked by the configs, as every override is (experiments/run/trial_config.py)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,7 @@
 """What a user chooses for one trial, checked before anything is written.
 
-`TrialSettings` are the choices of `playroom run` (and of each trial of a batch); `full_config`
-makes every setting of the trial from them, as config.json holds it, and checks every value
-(the configs check their own fields: sim/config.py, sim/vocal/config.py, learner/config.py).
+`TrialSettings` are the choices of `playroom run` (and of each trial of a batch), each checked
+on its own; the configs they make, every value checked, are experiments/run/trial_config.py's.
 `resume_settings` gives the settings of `playroom run --resume`: the trial's own, read from its
 config.json, which settings given on the command line must match.
 """
@@ -10,27 +9,22 @@ config.json, which settings given on the command line must match.
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 from dataclasses import dataclass
-from importlib.metadata import version
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 from experiments import storage
 from experiments.config_file import WORLD_CHOICES
 from experiments.file_names import CONFIG_FILE
 from experiments.run.trial_files import TrialError
-from learner.config import BABBLING_MODES, LearnerConfig, learner_preset
+from learner.config import BABBLING_MODES, LearnerConfig
 from models.checks import INT64_MAX, check_seed
 from models.presets import DEFAULT_PRESET, PRESETS
 from models.tracts import DEFAULT_TRACT, TRACTS
-from sim.config import STICK_RETURNS, WorldConfig, inert_settings, world_preset
+from sim.config import STICK_RETURNS, WorldConfig
 from sim.grasping.names import DEFAULT_GRASP
 from sim.grasping.registry import REGISTRY
-from sim.physics import PlayroomPhysics
-from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
-from sim.vocal.diva.data import DivaDataError, DivaDataMissing, installed_fit
 
 # Bounds of the trial's own settings. Iterations are logged as int64. A checkpoint period's rows
 # are held in memory until its checkpoint writes them, about a kilobyte each: a million is a GB.
@@ -127,81 +121,6 @@ def _check_overrides(overrides: object) -> None:
                 f"overrides.{section}: unknown settings {', '.join(map(str, unknown))} "
                 f"(known: {', '.join(sorted(known))})"
             )
-
-
-class TypedConfig(NamedTuple):
-    """A trial's settings typed once: its world, voice and learner configs, from which its room
-    and agent are built (`trial_files.trial_parts`), and `json`, the same as config.json holds
-    them."""
-
-    world: WorldConfig
-    voice: VoiceConfig
-    learner: LearnerConfig
-    json: dict
-
-
-def full_config(
-    settings: TrialSettings,
-    world: WorldConfig | None = None,
-    voice: VoiceConfig = DEFAULT_VOICE,
-    learner: LearnerConfig | None = None,
-) -> dict:
-    """Every setting of a trial, as written to config.json: what `fresh_trial_parts` builds
-    the trial's room and agent from. Every value is checked here, before a trial writes
-    anything: TrialError (one line) naming the setting and what it allows."""
-    return typed_config(settings, world, voice, learner).json
-
-
-def typed_config(
-    settings: TrialSettings,
-    world: WorldConfig | None = None,
-    voice: VoiceConfig = DEFAULT_VOICE,
-    learner: LearnerConfig | None = None,
-) -> TypedConfig:
-    """`full_config`, with the typed configs it was made from (a run builds its room and agent
-    from these, without reading its own JSON back)."""
-    changes = settings.overrides
-    try:
-        learner = learner or learner_preset(
-            settings.preset, **{"babbling": settings.babbling, **changes.get("learner", {})}
-        )
-        world = world or world_preset(
-            settings.preset,
-            **{
-                **{name: getattr(settings, name) for name in WORLD_CHOICES},
-                **changes.get("world", {}),
-            },
-        )
-        # The MJCF's lengths must equal the world's (sim/physics.py): refused now rather than
-        # when the room is built, after config.json is written. A load costs milliseconds.
-        PlayroomPhysics.load(world)
-    except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
-        raise TrialError(f"overrides do not fit the configs: {exc}") from None
-    # A world switch no rule of the trial's backend reads would only be recorded: refused.
-    inert = inert_settings(settings.grasp, changes.get("world", {}))
-    if inert:
-        raise TrialError(
-            f"overrides.world.{inert[0]} changes nothing on the {settings.grasp} backend (none "
-            "of its rules reads it: sim/config.py); leave it out, or run it on a backend it acts "
-            "on (a batch of several backends: one batch per backend)"
-        )
-    if world.voice == "diva":
-        # Its data is the user's: checked before anything is written, never replaced by VTL.
-        try:
-            installed_fit()
-        except (DivaDataMissing, DivaDataError) as exc:
-            raise TrialError(str(exc)) from None
-    config = {
-        "trial": dataclasses.asdict(settings),
-        "world": dataclasses.asdict(world),
-        "voice": dataclasses.asdict(voice),
-        "learner": learner.to_dict(),
-        "package_version": version("playroom"),
-    }
-    # Through JSON and back, so that it compares equal to what config.json holds; strict JSON
-    # (no NaN or Infinity), as storage.write_json writes it.
-    as_json = json.loads(json.dumps(config, allow_nan=False))
-    return TypedConfig(world, voice, learner, as_json)
 
 
 def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialSettings:

@@ -33,7 +33,8 @@ from experiments.file_names import (
 from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path
 from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 from experiments.run import memory_segments, progress_bar, stop_requests
-from experiments.run.settings import TrialSettings, typed_config
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_config import typed_config
 from experiments.run.trial_files import WORDS_LOG_PERIOD, learner_values, log_row, trial_parts
 from experiments.run.trial_opening import open_trial_directory
 from models.layout import TOYS, block_slice

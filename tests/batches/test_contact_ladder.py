@@ -9,7 +9,7 @@ import dataclasses
 from pathlib import Path
 
 from experiments.batches.spec import BatchSpec, load_spec
-from experiments.run.settings import full_config
+from experiments.run.trial_config import full_config
 from experiments.storage import config_differences
 from sim.config import ACTS_ON, WorldConfig
 

@@ -33,8 +33,9 @@ from experiments.file_names import (
     STALE_PREFIX,
     eval_world_dir,
 )
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.run.trial_config import full_config
 from models.layout import ARM_DIM
 from sim import Playroom
 from sim.config import world_preset

@@ -11,7 +11,8 @@ from experiments.cli.report_commands import study_reference
 from experiments.file_names import BATCH_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_config import full_config
 
 
 def test_the_random_reference_draws_a_bar_of_its_commands(capsys):

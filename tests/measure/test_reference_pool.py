@@ -13,7 +13,8 @@ import pytest
 
 from experiments.measure import reference_pool, study_measure
 from experiments.measure.reference_pool import chunks_of, play_chunk, play_references
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_config import full_config
 
 SEED = 7
 COMMANDS = 60  # per ring

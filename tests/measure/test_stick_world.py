@@ -9,7 +9,8 @@ import dataclasses
 
 from experiments.cli.report_commands import study_reference
 from experiments.measure.stick import batch_worlds, grasp_rates
-from experiments.run.settings import TrialSettings, full_config
+from experiments.run.settings import TrialSettings
+from experiments.run.trial_config import full_config
 from experiments.storage import write_json
 from sim.config import world_preset
 

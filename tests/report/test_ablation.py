@@ -183,7 +183,7 @@ def test_each_ablation_config_changes_one_setting_of_its_preset(installed_genera
     study's own vocal tract (no preset has it: its data is the user's); all on the
     replication's first seeds."""
     from experiments.batches.spec import load_spec
-    from experiments.run.settings import full_config
+    from experiments.run.trial_config import full_config
 
     folder = resources.files("experiments.batches").joinpath("ablations")
     files = sorted((f for f in folder.iterdir() if f.name.endswith(".json")), key=lambda f: f.name)

@@ -18,7 +18,7 @@ from experiments.run.trial import Trial, run_trial
 ROOT = Path(experiments.__file__).resolve().parent
 # The trial's stages, in the order it calls them.
 STAGES = [
-    "run.settings",
+    "run.trial_config",
     "run.trial_files",
     "run.trial_opening",
     "provenance",

@@ -15,8 +15,9 @@ from experiments.analysis.results import _eval_numbers
 from experiments.cli.main import main
 from experiments.config_file import identity_form, with_added_settings
 from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
-from experiments.run.settings import TrialSettings, full_config, resume_settings
+from experiments.run.settings import TrialSettings, resume_settings
 from experiments.run.trial import run_trial
+from experiments.run.trial_config import full_config
 from experiments.run.trial_files import TrialError
 from learner.config import LearnerConfig
 from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict, world_preset

@@ -14,8 +14,9 @@ from experiments.batches.spec import BatchError, BatchSpec, load_spec
 from experiments.cli.main import main
 from experiments.file_names import CONFIG_FILE, PROVENANCE_FILE
 from experiments.log_layout import trial_identity
-from experiments.run.settings import TrialSettings, full_config, resume_settings
+from experiments.run.settings import TrialSettings, resume_settings
 from experiments.run.trial import run_trial
+from experiments.run.trial_config import full_config
 from experiments.run.trial_files import TrialError
 from sim.vocal.diva import data
 
