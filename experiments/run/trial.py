@@ -36,7 +36,7 @@ from experiments.run import memory_segments, progress_bar, stop_requests
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import typed_config
 from experiments.run.trial_files import WORDS_LOG_PERIOD, learner_values, log_row, trial_parts
-from experiments.run.trial_opening import open_trial_directory
+from experiments.run.trial_opening import OpenedTrial, open_trial_directory
 from models.layout import TOYS, block_slice
 
 _SOUND = block_slice("sound")
@@ -65,7 +65,21 @@ class Trial:
         )
         parts = build()
         opened = open_trial_directory(out_dir, settings, self.config, parts, build, resume)
-        self.dir, self._lock, self.notices = opened.dir, opened.lock, opened.notices
+        self._lock = opened.lock  # held from here: `close` gives it up
+        try:
+            self._take(opened)
+            if not self.finished:  # who computes from here on (provenance.json)
+                self.notices += provenance.record_start(
+                    self.dir, self.iteration, self.room.vocal_tract.data_record()
+                )
+            self._record_backend()
+        except BaseException:
+            self.close()
+            raise
+
+    def _take(self, opened: OpenedTrial) -> None:
+        """Where the run starts: what the opening returned."""
+        self.dir, self.notices = opened.dir, opened.notices
         self.identity, self.source = opened.identity, opened.source
         self.agent, self.room = opened.agent, opened.room
         self.iteration = opened.iteration
@@ -86,15 +100,6 @@ class Trial:
         self.unrecorded = opened.unrecorded
         self.elapsed: float | None = None  # seconds of the last `run_trial`
         self.start_iteration = self.iteration
-        try:
-            if not self.finished:  # who computes from here on (provenance.json)
-                self.notices += provenance.record_start(
-                    self.dir, self.iteration, self.room.vocal_tract.data_record()
-                )
-            self._record_backend()
-        except BaseException:
-            self.close()
-            raise
 
     def close(self) -> None:
         """Give up the directory's lock."""
