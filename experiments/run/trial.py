@@ -83,18 +83,7 @@ class Trial:
         self.identity, self.source = opened.identity, opened.source
         self.agent, self.room = opened.agent, opened.room
         self.iteration = opened.iteration
-        words = len(self.room.vocal_tract.config.words)
-        self.best_word_distance = (
-            np.full(words, np.inf)
-            if opened.best_word_distance is None
-            else opened.best_word_distance
-        )
-        self.counts = opened.counts or {
-            "tool_uses": 0,
-            "words_recognised": 0,
-            "diverged": 0,
-            "stick_returns": 0,
-        }
+        self.best_word_distance, self.counts = opened.best_word_distance, opened.counts
         self.memory = opened.memory  # what the memory's segments hold: each checkpoint the rest
         self.manifest_pointer, self.recorded = opened.manifest_pointer, opened.recorded
         self.unrecorded = opened.unrecorded

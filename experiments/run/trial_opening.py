@@ -38,6 +38,9 @@ from experiments.run.trial_files import LOG_README, TrialError, TrialLocked
 from learner.agent import Agent
 from sim import Playroom
 
+# What a trial counts as it runs (its checkpoints keep them; `playroom run` prints them).
+COUNTS = ("tool_uses", "words_recognised", "diverged", "stick_returns")
+
 
 @dataclass
 class OpenedTrial:
@@ -51,9 +54,9 @@ class OpenedTrial:
     source: dict  # first in every log row
     agent: Agent
     room: Playroom
+    best_word_distance: np.ndarray  # to each word, the best reached so far
+    counts: dict[str, int]  # of COUNTS
     iteration: int = 0
-    best_word_distance: np.ndarray | None = None  # None: none reached yet
-    counts: dict | None = None  # None: all zero
     memory: memory_segments.MemoryOnDisk = field(
         default_factory=lambda: memory_segments.MemoryOnDisk({}, None, 0)
     )
@@ -127,7 +130,11 @@ def _opened(
     restored = prepare_resume(d, config, parts, build, notices) if resume else None
     if restored is None:
         agent, room = parts
-        opened = OpenedTrial(d, lock, identity, source, agent, room, notices=notices)
+        unreached = np.full(len(room.vocal_tract.config.words), np.inf)
+        counts = dict.fromkeys(COUNTS, 0)
+        opened = OpenedTrial(
+            d, lock, identity, source, agent, room, unreached, counts, notices=notices
+        )
     else:
         agent, room, meta, recorded = restored
         opened = OpenedTrial(
@@ -137,9 +144,9 @@ def _opened(
             {**source, "trial": created_as(d, meta, str(source["trial"]))},
             agent,
             room,
-            iteration=int(meta["iteration"]),
             best_word_distance=np.asarray(meta["best_word_distance"], dtype=float),
             counts=dict(meta["counts"]),
+            iteration=int(meta["iteration"]),
             memory=memory_segments.on_disk(meta),
             manifest_pointer=meta.get(manifest.MANIFEST_KEY),
             recorded=recorded,
