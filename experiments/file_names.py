@@ -83,6 +83,9 @@ TRAINING_FILE = "training.json"
 
 # What a batch is: its spec as `playroom batch` last ran it (experiments/batches/spec.py).
 BATCH_FILE = "batch.json"
+# What a batch's submitter writes into the batch directory for its workers to read back (the
+# same path on a shared filesystem), one per run, removed when the run ends: NAME.format(run).
+WORKER_TOKEN_FILE = ".workers-{}.token"
 
 # Pages about a batch ------------------------------------------------------------------------
 REPORT_FILE = "report.html"

@@ -23,7 +23,7 @@ import sys
 import threading
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from concurrent.futures import CancelledError
 from pathlib import Path
 
@@ -32,6 +32,7 @@ from tqdm import tqdm
 from experiments import manifest, storage
 from experiments.analysis.eval_world_results import check_evaluation
 from experiments.batches import scheduler as dask_scheduler
+from experiments.batches import worker_check, workers
 from experiments.batches.directory import check_directory
 from experiments.batches.progress import (
     REPORT_EVERY,
@@ -54,7 +55,7 @@ from experiments.file_names import (
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run import estimate, memory_segments, stop_requests
+from experiments.run import estimate, memory_segments
 from experiments.run.lock import DirectoryLock, DirectoryLocked
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
@@ -65,11 +66,6 @@ from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 # How long a batch task waits for another writer of its trial to finish (s): longer than a
 # trial of the paper profile takes on one core.
 LOCK_WAIT_S = 4 * 3600
-# How often a batch waiting for its trials looks for a stop request Python dropped (s).
-STOP_POLL_S = 0.2
-# How often Dask runs a task again that raised: for faults of a worker or machine that may pass
-# (a full disk freed, a file system back). A lost worker is rescheduled apart from these.
-RETRIES = 2
 # Failures that running the trial again would only repeat: a damaged or foreign trial
 # directory, settings its files refuse, another writer past the wait, the user's DIVA data
 # missing. A task returns them (`TrialFailed`) instead of raising, so that Dask neither retries
@@ -250,6 +246,8 @@ def run_batch(
     notify: Callable[[str], None] | None = None,
     report_every: int = REPORT_EVERY,
     report_interval_s: float = REPORT_INTERVAL_S,
+    retries: int = workers.RETRIES,
+    worker_wait_s: float = workers.WORKER_WAIT_S,
 ) -> dict[str, dict]:
     """Run every trial of `spec` under out_dir (skipping completed ones); returns the
     evaluation summary of each trial run now, by name. Trials that fail are reported and the
@@ -258,7 +256,10 @@ def run_batch(
     the lines said while trials run (default: stderr); `progress`: a bar of the iterations
     done across the trials, moved at most every `report_interval_s` by each trial (looked at
     every `report_every` iterations)
-    (experiments/batches/progress.py)."""
+    (experiments/batches/progress.py). Every worker is checked before it runs a trial
+    (experiments/batches/workers.py): BatchError naming an unfit one, and one when no worker
+    comes within `worker_wait_s`; a trial is run again `retries` times after its worker dies
+    or a fault that may pass."""
     # Workers may run in another directory, or on another machine sharing the file system:
     # they are sent the path the user meant, not one relative to where they run.
     out = Path(os.path.abspath(Path(out_dir).expanduser()))
@@ -300,13 +301,21 @@ def run_batch(
     progress_topic = f"{topic}-progress"
     results: dict[str, dict] = {}
     failures: dict[str, str] = {}
-    listening = False
+    listening = recorded = made = False
+    token = out / "none"
     try:  # from here on, the cluster this batch started is closed however the batch ends
+        where = scheduler or "the batch's local cluster"
+        workers.wait_for_workers(client, where, worker_wait_s)
         try:
-            out.mkdir(parents=True, exist_ok=True)
+            made = workers.created(out)
+            token, secret = workers.write_token(out, run)
         except OSError as exc:
-            raise BatchError(f"cannot create {out}: {exc.strerror}") from None
+            raise BatchError(f"cannot write into {out}: {exc.strerror}") from None
+        expected = {"code": workers.code_expected(), "token_path": str(token), "token": secret}
+        workers.check_workers(client, expected)
+        workers.allow_failures(client, retries)
         _record(spec, out)
+        recorded = True
         # Where to watch the cluster (tasks, workers, memory), whichever cluster it is.
         link = dashboard_link(client)
         where = link or "none (the scheduler serves none)"
@@ -318,24 +327,32 @@ def run_batch(
         for name, settings in todo:
             trial_dir = out / name
             key = task_key(name, trial_dir, settings, spec.eval_placements, run)
+            # The worker is checked on itself before it runs the trial (one that joined late).
             future = client.submit(
-                run_and_evaluate, str(trial_dir), settings, spec.eval_placements, topic,
-                progress_topic, report_every, report_interval_s, spec.eval_worlds, key=key,
-                pure=False, retries=RETRIES,
+                worker_check.guarded_trial, expected, str(trial_dir),
+                dataclasses.asdict(settings), spec.eval_placements, topic, progress_topic,
+                report_every, report_interval_s, spec.eval_worlds, key=key, pure=False,
+                retries=retries,
             )  # fmt: skip
             futures[future] = name
         if skipped and progress:
             shown.say(f"skipping {skipped} complete trial(s)")
-        for future in _as_finished(futures):
+        watch = workers.WorkerWatch(client, where, shown.say)
+        for future in dask_scheduler.as_finished(futures, watch.look):
             name = futures[future]
             try:
                 result = future.result()
             except Exception as exc:  # a trial's error must not stop the others
                 # Only a lost scheduler cancels a batch's tasks: its keys are its own.
                 if isinstance(exc, CancelledError) or dask_scheduler.scheduler_lost(client):
-                    raise _lost(scheduler, todo, results) from None
-                failures[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+                    raise dask_scheduler.lost_error(scheduler, len(todo) - len(results)) from None
+                failures[name] = dask_scheduler.failure_text(exc, retries)
             else:
+                if isinstance(result, dict) and worker_check.UNFIT in result:
+                    raise BatchError(
+                        f"{result[worker_check.UNFIT]}; the batch stopped (the trials other "
+                        "workers run resume from their checkpoints when it is run again)"
+                    )
                 if isinstance(result, TrialFailed):
                     failures[name] = result.error
                 else:
@@ -347,6 +364,9 @@ def run_batch(
         logging.getLogger("distributed").setLevel(logging.CRITICAL)
         raise
     finally:
+        workers.remove_token(token)
+        if not recorded:  # refused before anything was written: the directory made now goes
+            workers.undo_created(out, made)
         try:
             shown.close()  # waits for stderr: a second Ctrl-C there still closes the cluster
         finally:
@@ -362,24 +382,6 @@ def run_batch(
     return results
 
 
-def _as_finished(futures: dict) -> Iterator:
-    """The futures as they finish (distributed's `as_completed`), looking every
-    STOP_POLL_S, while none finishes, for a stop request whose exception Python dropped in a
-    finalizer (experiments/run/stop_requests.py): as_completed alone would wait for the next
-    trial to end, minutes, before the batch heard it."""
-    from distributed import as_completed
-
-    finished = as_completed(futures)
-    while finished.count():
-        ready = finished.next_batch(block=False)
-        if not ready:
-            stop_requests.raise_if_requested()
-            time.sleep(STOP_POLL_S)
-        for future in ready:
-            stop_requests.raise_if_requested()
-            yield future
-
-
 def _record(spec: BatchSpec, out: Path) -> None:
     """Write what the batch is into its directory (batch.json): its reports read the size of
     the study's random reference from it (experiments/analysis/batch_record.py)."""
@@ -387,13 +389,3 @@ def _record(spec: BatchSpec, out: Path) -> None:
         storage.write_json(out / BATCH_FILE, spec_record(spec))
     except OSError as exc:
         raise BatchError(f"cannot write {out / BATCH_FILE}: {exc.strerror}") from None
-
-
-def _lost(scheduler: str | None, todo: list, results: dict) -> BatchError:
-    """The error of a batch whose scheduler went away."""
-    where = f"at {scheduler}" if scheduler else "of the batch"
-    left = len(todo) - len(results)
-    return BatchError(
-        f"lost the Dask scheduler {where} with {left} trial(s) unfinished; run the same "
-        "command again: complete trials are kept, the others resume from their checkpoints"
-    )

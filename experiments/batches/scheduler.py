@@ -14,8 +14,12 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
+
+from experiments.batches.spec import BatchError
+from experiments.run import stop_requests
 
 
 class SchedulerError(Exception):
@@ -26,6 +30,8 @@ class SchedulerError(Exception):
 # longer to wait for its first reply once connected.
 CONNECT_TIMEOUT_S = 10
 REPLY_TIMEOUT_S = 5
+# How often a batch waiting for its trials looks for a stop request Python dropped (s).
+STOP_POLL_S = 0.2
 
 
 def check_address(address: str) -> None:
@@ -174,3 +180,54 @@ def tell_client(topic: str | None, line: str) -> None:
 def listen(client, topic: str, notify: Callable[[str], None]) -> None:
     """Call `notify(line)` for every line a task sends under `topic`."""
     client.subscribe_topic(topic, lambda event: notify(str(event[1])))
+
+
+def as_finished(futures: dict, look: Callable[[], None]) -> Iterator:
+    """The futures as they finish (distributed's `as_completed`), looking every
+    STOP_POLL_S, while none finishes, for a stop request whose exception Python dropped in a
+    finalizer (experiments/run/stop_requests.py): as_completed alone would wait for the next
+    trial to end, minutes, before the batch heard it; `look()` is called then too."""
+    from distributed import as_completed
+
+    finished = as_completed(futures)
+    while finished.count():
+        ready = finished.next_batch(block=False)
+        if not ready:
+            stop_requests.raise_if_requested()
+            look()
+            time.sleep(STOP_POLL_S)
+        for future in ready:
+            stop_requests.raise_if_requested()
+            yield future
+
+
+def lost_error(scheduler: str | None, unfinished: int) -> BatchError:
+    """The error of a batch whose scheduler went away: what to restart, then to run again.
+    Workers of a user's scheduler exit when it goes (`dask worker` gives up reconnecting)."""
+    if scheduler is None:
+        restart = "run the same command again"
+    else:
+        restart = (
+            "start the scheduler again and its workers with it (`dask scheduler`, then `dask "
+            "worker ADDRESS` on each machine, or `playroom cluster`: its workers exited with "
+            "it), then run the same command again with the new address"
+        )
+    return BatchError(
+        f"lost the Dask scheduler {'at ' + scheduler if scheduler else 'of the batch'} with "
+        f"{unfinished} trial(s) unfinished; {restart}: complete trials are kept, the others "
+        "resume from their checkpoints"
+    )
+
+
+def failure_text(exc: BaseException, retries: int) -> str:
+    """A trial's failure on one line; a trial whose worker died once more than `retries`
+    allows (Dask's KilledWorker) says so and what to do."""
+    from distributed.scheduler import KilledWorker
+
+    if isinstance(exc, KilledWorker):
+        return (
+            f"its worker died {retries + 1} times while running it (Dask's KilledWorker): run "
+            "the batch again to resume it from its checkpoint, and allow more deaths with "
+            "--retries N if workers are preempted"
+        )
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())}"

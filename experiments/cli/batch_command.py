@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 
 from experiments.batches.stored import stored_profiles
+from experiments.batches.workers import RETRIES, WORKER_WAIT_S
 from experiments.cli.args import (
     UsageError,
+    non_negative_int,
     percent,
     positive_int,
     set_option,
@@ -31,6 +33,23 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="a running Dask scheduler (default: a local cluster, its dashboard on a free port)",
     )
     p.add_argument("--workers", type=positive_int, help="local worker processes (default: cores)")
+    p.add_argument(
+        "--retries",
+        type=non_negative_int,
+        default=RETRIES,
+        metavar="N",
+        help="how many times a trial is run again, from its checkpoint, after its worker dies "
+        "or a fault that may pass (a full disk); the scheduler's allowed failures for every "
+        f"client (default: {RETRIES}, Dask's own)",
+    )
+    p.add_argument(
+        "--worker-wait",
+        type=positive_int,
+        default=WORKER_WAIT_S,
+        metavar="SECONDS",
+        help="how long to wait for a first worker of the scheduler before giving up "
+        f"(default: {WORKER_WAIT_S})",
+    )
     set_option(p, "merged into the batch's overrides")
     p.add_argument(
         "--quiet",
@@ -54,7 +73,7 @@ def cmd_batch(args: argparse.Namespace) -> None:
                 raise BatchError(str(exc)) from None
         results = run_batch(
             spec, args.out, scheduler=args.scheduler, n_workers=args.workers,
-            progress=not args.quiet,
+            progress=not args.quiet, retries=args.retries, worker_wait_s=args.worker_wait,
         )  # fmt: skip
     except BatchError as exc:
         raise UsageError(str(exc)) from None

@@ -2,7 +2,8 @@
 
 The lock is `flock` on a file in the directory, so the kernel releases it whenever the holding
 process ends, `kill -9` and a lost Dask worker included: a stale lock cannot outlive its
-holder. The holder writes its process id into the file so that a refused writer can name it.
+holder. The holder writes its process id and host into the file so that a refused writer can
+name it: on a cluster the holder is often on another machine, where its pid means nothing.
 Within one process the lock is re-entrant (a batch task runs a trial, then evaluates it).
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import socket
 import time
 from pathlib import Path
 
@@ -17,6 +19,17 @@ from experiments.file_names import LOCK_FILE
 
 # How often a waiting writer tries again (s).
 POLL_S = 0.5
+# How much of the lock file a refused writer reads: a pid and a host name (at most 255 bytes).
+HOLDER_BYTES = 300
+
+
+def _holder_text(holder: str) -> str:
+    """The holder as the lock file names it, "pid P on HOST" (a lock written before hosts were
+    recorded names only its pid)."""
+    pid, _, host = holder.partition(" ")
+    if not pid:
+        return "pid unknown"
+    return f"pid {pid} on {host}" if host else f"pid {pid}"
 
 
 class DirectoryLocked(Exception):
@@ -56,15 +69,15 @@ class DirectoryLock:
                 break
             except BlockingIOError:
                 if time.monotonic() >= deadline:
-                    holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+                    holder = os.pread(fd, HOLDER_BYTES, 0).decode(errors="replace").strip()
                     os.close(fd)
                     raise DirectoryLocked(
-                        f"{self.directory} is being written by another process (pid {holder}); "
-                        "wait for it to finish or stop it"
+                        f"{self.directory} is being written by another process "
+                        f"({_holder_text(holder)}); wait for it to finish or stop it"
                     ) from None
                 time.sleep(POLL_S)
         os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
         self._fd = fd
         DirectoryLock._held[self.directory] = (self, 1)
         return self
