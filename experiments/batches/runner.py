@@ -33,6 +33,7 @@ from experiments import manifest, storage
 from experiments.analysis.eval_world_results import check_evaluation
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches import worker_check, workers
+from experiments.batches.cluster_settings import RETRIES, WORKER_WAIT_S
 from experiments.batches.directory import check_directory
 from experiments.batches.progress import (
     REPORT_EVERY,
@@ -246,8 +247,8 @@ def run_batch(
     notify: Callable[[str], None] | None = None,
     report_every: int = REPORT_EVERY,
     report_interval_s: float = REPORT_INTERVAL_S,
-    retries: int = workers.RETRIES,
-    worker_wait_s: float = workers.WORKER_WAIT_S,
+    retries: int = RETRIES,
+    worker_wait_s: float = WORKER_WAIT_S,
 ) -> dict[str, dict]:
     """Run every trial of `spec` under out_dir (skipping completed ones); returns the
     evaluation summary of each trial run now, by name. Trials that fail are reported and the

@@ -23,22 +23,12 @@ import cloudpickle  # type: ignore[import-untyped]
 
 from experiments import provenance
 from experiments.batches import worker_check
+from experiments.batches.cluster_settings import NO_WORKER_NOTICE_S, WORKER_COUNT_EVERY_S
 from experiments.batches.spec import BatchError
 from experiments.file_names import WORKER_TOKEN_FILE
 
 # Sent by value: the check must run on a worker that cannot import the project.
 cloudpickle.register_pickle_by_value(worker_check)
-
-# How long a batch waits for a first worker before it gives up (s; `--worker-wait`): a
-# scheduler whose workers are queued jobs may need minutes.
-WORKER_WAIT_S = 600
-# How long a running batch may have no worker before it says so, once (s).
-NO_WORKER_NOTICE_S = 60
-# How often a running batch counts its workers (s).
-WORKER_COUNT_EVERY_S = 5
-# How many times a trial is run again after its worker dies, or after a fault that may pass
-# (a full disk freed, a file system back) (`--retries`): Dask's own default allowed failures.
-RETRIES = 3
 
 
 def code_expected() -> dict:

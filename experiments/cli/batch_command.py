@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from experiments.batches.cluster_settings import RETRIES, WORKER_WAIT_S
 from experiments.batches.stored import stored_profiles
-from experiments.batches.workers import RETRIES, WORKER_WAIT_S
 from experiments.cli.args import (
     UsageError,
     non_negative_int,
