@@ -10,7 +10,9 @@ import shlex
 import signal
 import subprocess
 import sys
+import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -24,6 +26,9 @@ from experiments.run.lock import DirectoryLock
 # -X faulthandler: a run that outlives its signal shows where it was (SIGABRT below).
 PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli.main"]
 REPO = Path(__file__).resolve().parents[2]
+# The pause between two looks at a trial directory for its next checkpoint (seconds): how
+# often the tests look, never how long they wait.
+LOOK_EVERY_S = 0.025
 
 
 def _checkpointed(trial: Path) -> int:
@@ -38,29 +43,51 @@ def _interruptible() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+def _wait_for_checkpoint(trial: Path, past: int, ended: Callable[[], bool]) -> bool:
+    """Wait until the trial has a checkpoint past iteration `past` (True), or until `ended()`
+    says that what writes the trial has stopped without one (False). However long that takes:
+    the wait ends on what the trial does, never on a count of looks, which is a clock in
+    disguise (a bound of 1200 looks, some 30 s, sent the signal anyway on a machine loaded by
+    `make test-slow`, to a trial that had no checkpoint yet)."""
+    while _checkpointed(trial) <= past:
+        if ended():
+            return False
+        time.sleep(LOOK_EVERY_S)
+    return True
+
+
 def _stop_after(command: list[str], trial: Path, past: int, signum: int, **popen) -> tuple:
     """Start `command`, send `signum` once the trial has a checkpoint past iteration `past`;
     (exit code, stderr)."""
-    # As from a terminal: Ctrl-C interrupts. A pytest-xdist worker ignores SIGINT, and a child
-    # inherits that (a process started ignoring SIGINT, as under nohup, is meant to ignore it).
-    proc = subprocess.Popen(
-        command, stderr=subprocess.PIPE, text=True, cwd=REPO, preexec_fn=_interruptible, **popen
-    )
-    for _ in range(1200):  # polls every 25 ms; no clock is read
-        if _checkpointed(trial) > past or proc.poll() is not None:
-            break
-        time.sleep(0.025)
-    if popen.get("start_new_session"):
-        os.killpg(proc.pid, signum)  # as a terminal or a job scheduler signals a whole job
-    else:
-        proc.send_signal(signum)
-    try:
-        _, err = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:
-        proc.send_signal(signal.SIGABRT)
-        _, err = proc.communicate()
-        raise AssertionError(f"still running 60 s after signal {signum}:\n{err}") from None
-    return proc.returncode, err
+    # stderr goes to a file, not a pipe: a pipe nobody reads while the test waits would block
+    # the command once full.
+    with tempfile.TemporaryFile("w+") as stderr:
+        # As from a terminal: Ctrl-C interrupts. A pytest-xdist worker ignores SIGINT, and a
+        # child inherits that (a process started ignoring SIGINT, as under nohup, is meant to
+        # ignore it).
+        proc = subprocess.Popen(
+            command, stderr=stderr, text=True, cwd=REPO, preexec_fn=_interruptible, **popen
+        )
+        if not _wait_for_checkpoint(trial, past, lambda: proc.poll() is not None):
+            stderr.seek(0)
+            raise AssertionError(
+                f"ended ({proc.returncode}) before a checkpoint past {past}:\n{stderr.read()}"
+            )
+        if popen.get("start_new_session"):
+            os.killpg(proc.pid, signum)  # as a terminal or a job scheduler signals a whole job
+        else:
+            proc.send_signal(signum)
+        try:
+            proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGABRT)
+            proc.wait()
+            stderr.seek(0)
+            raise AssertionError(
+                f"still running 60 s after signal {signum}:\n{stderr.read()}"
+            ) from None
+        stderr.seek(0)
+        return proc.returncode, stderr.read()
 
 
 def _lock_is_free(trial: Path) -> bool:
@@ -111,7 +138,20 @@ def test_sigterm_ends_a_batch_with_one_line_saying_how_to_resume(tmp_path):
     last = err.rstrip("\n").split("\n")[-1]
     assert last.startswith("playroom batch: interrupted")
     assert f"rerun the same command to resume: playroom batch --config {config}" in last
-    assert _checkpointed(trial) > 0 and _lock_is_free(trial)
+    first = _checkpointed(trial)
+    assert first > 0 and _lock_is_free(trial)
+
+    # The command the line gives resumes the trial from its checkpoint.
+    again = shlex.split(last.split("rerun the same command to resume: ")[1])
+    assert again[0] == "playroom"
+    code, err = _stop_after(
+        [*PLAYROOM, *again[1:]], trial, first, signal.SIGTERM, start_new_session=True
+    )
+    assert code == 143, err
+    assert err.rstrip("\n").split("\n")[-1] == last
+    second = _checkpointed(trial)
+    assert second > first and _lock_is_free(trial)
+    assert list(read_log(trial)["iteration"]) == list(range(second))  # nothing lost or doubled
 
 
 # The handler itself, in this process -------------------------------------------------------------
@@ -195,11 +235,11 @@ def test_a_batch_waiting_for_its_trials_hears_a_stop_python_dropped(tmp_path):
     out = tmp_path / "batch"
     trial = out / "kinematic-random-seed0000"
 
+    batch_ended = threading.Event()
+
     def stop_once_the_trial_runs() -> None:
-        for _ in range(1200):  # polls every 25 ms; no clock is read
-            if _checkpointed(trial) > 0:
-                break
-            time.sleep(0.025)
+        if not _wait_for_checkpoint(trial, 0, batch_ended.is_set):
+            return  # the batch ended by itself: pytest.raises below says so
         try:  # the handler records the request; its exception is lost in this thread
             stop_requests.handle(signal.SIGTERM, None)
         except stop_requests.Terminated:
@@ -211,6 +251,7 @@ def test_a_batch_waiting_for_its_trials_hears_a_stop_python_dropped(tmp_path):
         with pytest.raises(stop_requests.Terminated):
             run_batch(spec, out, n_workers=1, progress=False)
     finally:
+        batch_ended.set()
         stopper.join()
         stop_requests.clear()
     assert 0 < _checkpointed(trial) < 100000

@@ -8,8 +8,10 @@ import shutil
 
 import pandas as pd
 import pytest
+from old_trials import as_evaluated_before_names_had_toys
 
 from experiments.analysis.results import collect
+from experiments.file_names import EVAL_FILE
 from experiments.measure.for_reports import room_measures
 from experiments.report.batch_report import write_report
 from experiments.report.name_strategies import (
@@ -103,11 +105,11 @@ def test_the_report_shows_the_table_or_says_why_not(batches, tmp_path):
     ).read_text()
     assert "Strategies by the toy&#39;s name" in page or "Strategies by the toy's name" in page
     assert "names said within the distance" in page or "names never said" in page
-    # A trial evaluated before: its vocal table without `toy`.
+    # Trials evaluated before the vocal table recorded the toy, as that version wrote them.
     batch = tmp_path / "old"
     shutil.copytree(batches["kinematic"], batch)
-    for path in batch.glob("*/vocal.parquet"):
-        pd.read_parquet(path).drop(columns="toy").to_parquet(path)
+    for eval_file in batch.glob(f"*/{EVAL_FILE}"):
+        as_evaluated_before_names_had_toys(eval_file.parent)
     page = write_report(batch, tmp_path / "old-report", measures=room_measures(50)).read_text()
     assert "playroom eval" in page and NOT_RECORDED.split(":")[0] in page
 
