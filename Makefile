@@ -18,12 +18,13 @@ $(INSTALLED): pyproject.toml $(LOCK)
 	touch $(INSTALLED)
 
 ## lock: regenerate constraints.txt: the newest versions pyproject.toml's ranges allow today,
-## resolved by pip in a fresh virtual environment of this Python
+## resolved by pip in a fresh virtual environment of this Python (the dev and cluster extras
+## installed; the rl extra resolved without installing)
 lock:
 	rm -rf .lock-venv
 	$(PYTHON) -m venv .lock-venv
 	.lock-venv/bin/python -m pip install --quiet --upgrade pip
-	.lock-venv/bin/python -m pip install --quiet ".[dev]"
+	.lock-venv/bin/python -m pip install --quiet ".[dev,cluster]"
 	{ echo "# Exact versions for make run / make test, written by make lock on $$(date -u +%Y-%m-%d)"; \
 	  echo "# with $$(.lock-venv/bin/python -c 'import platform; print(platform.python_implementation(), platform.python_version(), platform.machine())')."; \
 	  .lock-venv/bin/python -m pip freeze --all --exclude playroom; } > $(LOCK).new

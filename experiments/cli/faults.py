@@ -132,6 +132,15 @@ def _baseline_kept(args: argparse.Namespace, argv: list[str], then: str) -> str:
     )
 
 
+def _cluster_closed(args: argparse.Namespace, argv: list[str], then: str) -> str:
+    if args.print_script:
+        return "nothing was submitted"
+    return (
+        "its scheduler is closed and its jobs cancelled; a batch sent there stops, and resumes "
+        "when rerun on a new cluster's scheduler"
+    )
+
+
 def _nothing_written(args: argparse.Namespace, argv: list[str], then: str) -> str:
     return "nothing was written"
 
@@ -139,6 +148,7 @@ def _nothing_written(args: argparse.Namespace, argv: list[str], then: str) -> st
 KEPT: dict[str, Callable[[argparse.Namespace, list[str], str], str]] = {
     "run": _run_kept,
     "batch": _batch_kept,
+    "cluster": _cluster_closed,
     "eval": _eval_kept,
     "report": _nothing_written,
     "compare": _nothing_written,

@@ -12,6 +12,7 @@ from experiments.cli import (
     agent_measures_command,
     batch_command,
     bench_command,
+    cluster_command,
     ladder_command,
     report_commands,
     rl_behaviour_command,
@@ -28,6 +29,7 @@ from experiments.cli.faults import run_command
 COMMAND_MODULES = (
     trial_commands,
     batch_command,
+    cluster_command,
     report_commands,
     ladder_command,
     rl_command,
