@@ -18,7 +18,6 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 
-from experiments.batches.spec import BatchError
 from experiments.run import stop_requests
 
 
@@ -201,9 +200,12 @@ def as_finished(futures: dict, look: Callable[[], None]) -> Iterator:
             yield future
 
 
-def lost_error(scheduler: str | None, unfinished: int) -> BatchError:
+def lost_error(scheduler: str | None, unfinished: int) -> Exception:
     """The error of a batch whose scheduler went away: what to restart, then to run again.
     Workers of a user's scheduler exit when it goes (`dask worker` gives up reconnecting)."""
+    # Here, not at the top: the command line's help imports this module and not the specs.
+    from experiments.batches.spec import BatchError
+
     if scheduler is None:
         restart = "run the same command again"
     else:
