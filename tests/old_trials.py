@@ -1,13 +1,19 @@
 """Trials made to look as older versions of the project wrote them, for the tests that check
-such trials are still read, resumed and extended."""
+such trials are still read, resumed and extended (and their evaluations read)."""
 
 from __future__ import annotations
 
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
-from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, MANIFEST_DIR, PREVIOUS_CHECKPOINT_FILE
+from experiments import eval_record, storage
+from experiments.file_names import (
+    CHECKPOINT_FILE,
+    EVAL_FILE,
+    MANIFEST_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+)
 from experiments.manifest import MANIFEST_KEY
 
 # What checkpoints recorded of their directory since manifests.
@@ -28,3 +34,20 @@ def as_before_manifests(trial_dir: Path) -> None:
             arrays, meta = storage.read_arrays(trial_dir / name)
             storage.write_arrays(trial_dir / name, arrays, before_manifests(meta))
     shutil.rmtree(trial_dir / MANIFEST_DIR, ignore_errors=True)
+
+
+def rewritten_evaluation(folder: Path, config: dict, change: Callable[[dict], None]) -> None:
+    """The eval.json in `folder` (of the trial whose config.json is `config`) changed by
+    `change` and written again as the version that made it would have: intact, with its
+    checksum and trial recorded (an evaluation made otherwise, not a damaged one)."""
+    summary = eval_record.read_evaluation(folder, config, "")
+    change(summary)
+    storage.write_bytes(folder / EVAL_FILE, eval_record.evaluation_json(summary, config))
+
+
+def as_before_eval_checksums(folder: Path) -> None:
+    """The eval.json in `folder` as written before it recorded its checksum and its trial."""
+    summary = storage.read_json(folder / EVAL_FILE)
+    for key in (eval_record.CHECKSUM_KEY, eval_record.IDENTITY_KEY):
+        summary.pop(key)
+    storage.write_json(folder / EVAL_FILE, summary)
