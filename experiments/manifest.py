@@ -10,7 +10,8 @@ previous checkpoint is kept beside the newest. config.json is not listed either:
 rewrites it when the trial is extended, and its content is checked otherwise (each
 checkpoint, chunk and segment carries a hash of it: experiments/log_layout.py `trial_identity`).
 An evaluation's tables are listed in its own eval.json (`EVAL_FILES_KEY`), which is written
-after them (experiments/storage.py `write_files`).
+after them (experiments/storage.py `write_files`) and records its own checksum and trial
+(experiments/eval_record.py: written after the last checkpoint, no manifest can list it).
 
 How it is kept: append-only, as the memory is (experiments/run/memory_segments.py), so that
 a checkpoint's cost does not grow with the trial. Each checkpoint writes the entries of the
@@ -66,6 +67,22 @@ class DamagedFileError(storage.CorruptFileError):
 
 class UncheckedTrialWarning(UserWarning):
     """A trial written before manifests was read: its files could not be checked."""
+
+    # What the warning says of the trials it names, and what to do.
+    what = (
+        "written before trials recorded a manifest of their files, read unchecked "
+        "(`playroom run --out DIR --resume` with more --iterations records one)"
+    )
+
+
+class UncheckedEvaluationWarning(UncheckedTrialWarning):
+    """An evaluation written before eval.json recorded its checksum and its trial was read: it
+    could not be checked (experiments/eval_record.py)."""
+
+    what = (
+        "evaluated before eval.json recorded its checksum and its trial, read unchecked "
+        "(evaluating it again records them: `playroom eval DIR` for a trial)"
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -272,28 +289,33 @@ def drop_past(trial_dir: Path, iteration: int) -> None:
             path.unlink()
 
 
-def warn_unchecked(trials: str | os.PathLike) -> None:
-    """One line: the `trials` (a trial directory, or words naming several) predate manifests,
-    their files are read as they are."""
-    warnings.warn(
-        f"{trials}: written before trials recorded a manifest of their files, read unchecked "
-        "(`playroom run --out DIR --resume` with more --iterations records one)",
-        UncheckedTrialWarning,
-        stacklevel=3,
-    )
+def warn_unchecked(
+    trials: str | os.PathLike, category: type[UncheckedTrialWarning] = UncheckedTrialWarning
+) -> None:
+    """One line: the `trials` (a trial directory, or words naming several) predate manifests
+    (or, `category` UncheckedEvaluationWarning, their eval.json predates its checksum), their
+    files are read as they are."""
+    warnings.warn(f"{trials}: {category.what}", category, stacklevel=3)
 
 
 def warn_unchecked_once(
     batch_dir: Path, dirs: list[Path], caught: list[warnings.WarningMessage]
 ) -> None:
-    """The warnings reading a batch's trials raised (`caught`), again, those of trials written
-    before manifests as one line for the batch."""
-    unchecked = [d.name for d in dirs if any(str(d) in str(w.message) for w in caught)]
+    """The warnings reading a batch's trials raised (`caught`), again, those of trials read
+    unchecked as one line for the batch per kind (UncheckedTrialWarning and its subclasses)."""
+    unchecked: dict[type[UncheckedTrialWarning], list[str]] = {}
     for w in caught:
         if not issubclass(w.category, UncheckedTrialWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    if unchecked:
-        warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
+            continue
+        names = unchecked.setdefault(w.category, [])
+        text = str(w.message)  # names a trial directory, or a file in it
+        named = [d.name for d in dirs if f"{d}:" in text or f"{d}{os.sep}" in text]
+        names += [name for name in named if name not in names]
+    for category, names in unchecked.items():
+        if names:
+            trials = f"{len(names)} trial(s) of {batch_dir} ({names[0]}, ...)"
+            warn_unchecked(trials, category)
 
 
 def evaluation_files(files: dict[str, bytes]) -> dict[str, list]:

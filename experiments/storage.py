@@ -30,8 +30,9 @@ _TEMPORARY = re.compile(r"\.(?P<name>.+)\.(?P<pid>[0-9]+)\.tmp")
 
 
 def temporary_writer(name: str) -> int | None:
-    """The process id of the writer of a temporary file of `write_bytes` named `name` (a file
-    that a writer killed mid-write may leave behind); None if `name` is not such a file."""
+    """The process id of the writer of a temporary file of `write_bytes` (or `check_writable`'s
+    probe) named `name` (a file that a writer killed mid-write may leave behind); None if
+    `name` is not such a file."""
     match = _TEMPORARY.fullmatch(name)
     return None if match is None else int(match["pid"])
 
@@ -129,7 +130,8 @@ def check_writable(directory: Path) -> None:
         directory = directory.parent
     if not directory.is_dir():
         raise WriteError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(directory))
-    probe = directory / f".write-test.{os.getpid()}"
+    # Named as `write_bytes` names its temporaries: one a kill leaves is cleaned with theirs.
+    probe = directory / f".write-test.{os.getpid()}.tmp"
     try:
         os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
         os.unlink(probe)

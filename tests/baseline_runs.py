@@ -31,5 +31,6 @@ def write_run(root, seed: int, steps: int = 30, placements: int = 1) -> None:
     config = summary_config(settings)
     summary, tables = measured(actor, actor, room, evaluation, config, np.full(6, np.inf), steps)
     out = root / run_name(settings)
-    record = storage.json_bytes({"settings": settings.record(), "trial": trial_config(settings)})
-    storage.write_files(out, {BASELINE_FILE: record, **evaluation_files(summary, tables)})
+    trial = trial_config(settings)
+    record = storage.json_bytes({"settings": settings.record(), "trial": trial})
+    storage.write_files(out, {BASELINE_FILE: record, **evaluation_files(summary, tables, trial)})

@@ -69,21 +69,26 @@ def trained_trial(tmp_path_factory):
 @pytest.fixture(scope="session")
 def batches(tmp_path_factory):
     """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0
-    (300 iterations, evaluated on 3 placements). Tests only read them."""
+    (300 iterations, evaluated on 3 placements), each with the record (batch.json) that
+    `playroom batch` writes. Tests only read them."""
+    from experiments import storage
+    from experiments.batches.spec import BatchSpec, spec_record
+    from experiments.file_names import BATCH_FILE
     from experiments.measure.evaluation import EvaluationSettings
     from experiments.measure.trial_evaluation import evaluate_trial
-    from experiments.run.settings import TrialSettings
     from experiments.run.trial import run_trial
 
     root = tmp_path_factory.mktemp("batches")
     out = {}
     for grasp, seeds in (("kinematic", (0, 1)), ("physical", (0,))):
         batch = root / grasp
-        for seed in seeds:
-            trial = batch / f"{grasp}-random-seed{seed:04d}"
-            settings = TrialSettings(grasp=grasp, iterations=300, seed=seed, checkpoint_every=300)
-            run_trial(trial, settings, progress=False)
-            evaluate_trial(trial, EvaluationSettings(n_placements=3))
+        spec = BatchSpec(
+            grasps=(grasp,), seeds=seeds, iterations=300, checkpoint_every=300, eval_placements=3
+        )
+        for name, settings in spec.trials():
+            run_trial(batch / name, settings, progress=False)
+            evaluate_trial(batch / name, EvaluationSettings(n_placements=spec.eval_placements))
+        storage.write_json(batch / BATCH_FILE, spec_record(spec))
         out[grasp] = batch
     return out
 

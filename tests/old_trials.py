@@ -1,12 +1,13 @@
 """Trials made to look as older versions of the project wrote them, for the tests that check
-such trials are still read, resumed and extended."""
+such trials are still read, resumed and extended (and their evaluations read)."""
 
 from __future__ import annotations
 
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
-from experiments import storage
+from experiments import eval_record, storage
 from experiments.file_names import (
     CHECKPOINT_FILE,
     EVAL_FILE,
@@ -45,5 +46,24 @@ def as_evaluated_before_names_had_toys(trial_dir: Path) -> None:
     vocal = storage.read_table(trial_dir / VOCAL_FILE).drop(columns="toy")
     storage.write_bytes(trial_dir / VOCAL_FILE, storage.table_bytes(vocal))
     summary = storage.read_json(trial_dir / EVAL_FILE)
-    del summary[EVAL_FILES_KEY]
+    # Neither its tables' list nor the checksum and trial identity, which came later still.
+    for key in (EVAL_FILES_KEY, eval_record.CHECKSUM_KEY, eval_record.IDENTITY_KEY):
+        summary.pop(key, None)
     storage.write_json(trial_dir / EVAL_FILE, summary)
+
+
+def rewritten_evaluation(folder: Path, config: dict, change: Callable[[dict], None]) -> None:
+    """The eval.json in `folder` (of the trial whose config.json is `config`) changed by
+    `change` and written again as the version that made it would have: intact, with its
+    checksum and trial recorded (an evaluation made otherwise, not a damaged one)."""
+    summary = eval_record.read_evaluation(folder, config, "")
+    change(summary)
+    storage.write_bytes(folder / EVAL_FILE, eval_record.evaluation_json(summary, config))
+
+
+def as_before_eval_checksums(folder: Path) -> None:
+    """The eval.json in `folder` as written before it recorded its checksum and its trial."""
+    summary = storage.read_json(folder / EVAL_FILE)
+    for key in (eval_record.CHECKSUM_KEY, eval_record.IDENTITY_KEY):
+        summary.pop(key)
+    storage.write_json(folder / EVAL_FILE, summary)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from experiments import eval_record, storage
 from experiments.analysis.batch_checks import shared_config
 from experiments.analysis.results import (
     BatchResults,
@@ -66,6 +67,19 @@ def is_baseline_dir(directory: Path) -> bool:
     return (directory / BASELINE_FILE).is_file()
 
 
+def _summary(run_dir: Path, config: dict) -> dict:
+    """A run's eval.json, checked against itself and the trial config its baseline.json
+    records (experiments/eval_record.py); ReportError (one line) otherwise."""
+    remedy = (
+        f"remove it and run the same `playroom rl-baseline` command into {run_dir} again "
+        "(its trained policies are kept)"
+    )
+    try:
+        return eval_record.read_evaluation(run_dir, config, remedy)
+    except storage.CorruptFileError as exc:
+        raise ReportError(" ".join(str(exc).split())) from None
+
+
 def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
     """Read every run of a folder (`playroom rl-baseline --config ... --out DIR`'s DIR) into
     tables. ReportError (one line) for a folder without runs, a run not evaluated, or a table
@@ -89,14 +103,12 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
     configs: dict[str, dict] = {}
     where = []
     for d in dirs:
-        summary = _read_json(d / EVAL_FILE)
-        if not isinstance(summary, dict) or "grasp" not in summary or "seed" not in summary:
-            raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
-        keys = {"trial": d.name, "group": summary["grasp"], "seed": summary["seed"]}
         recorded = _read_json(d / BASELINE_FILE)
         config = recorded.get("trial") if isinstance(recorded, dict) else None
-        if not isinstance(config, dict):
+        if not isinstance(config, dict) or not isinstance(config.get("trial"), dict):
             raise ReportError(f"{d / BASELINE_FILE} lacks the trial's config: run it again")
+        summary = _summary(d, config)
+        keys = {"trial": d.name, "group": summary["grasp"], "seed": summary["seed"]}
         if configs.setdefault(summary["grasp"], shared_config(config)) != shared_config(config):
             raise ReportError(
                 f"{d.name}: its world differs from the other {summary['grasp']} runs' in {root}"

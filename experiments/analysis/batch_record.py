@@ -10,9 +10,10 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from experiments import storage
+from experiments import eval_record, storage
 from experiments.config_file import with_added_settings
-from experiments.file_names import BATCH_FILE, CONFIG_FILE, EVAL_FILE
+from experiments.file_names import BATCH_FILE, CONFIG_FILE, MANIFEST_DIR
+from experiments.log_layout import is_trial_dir
 
 
 class RecordMismatch(ValueError):
@@ -47,14 +48,37 @@ def recorded_reference_commands(batch_dirs: Iterable[str | os.PathLike]) -> int 
     """The largest study reference size (random commands per ring) the batches record, so that
     a page setting a small batch beside a large one measures both as the large one asks; None
     where none records one (a batch written before batch.json: the study's size applies).
-    RecordMismatch for a record that cannot be read."""
+    RecordMismatch for a record that cannot be read, or that is missing from a batch whose
+    trials were written after records existed (`check_not_lost`)."""
     sizes = []
     for batch_dir in batch_dirs:
         record = read_batch_record(batch_dir)
+        if record is None:
+            check_not_lost(Path(batch_dir))
         size = record.get("study_reference_commands") if isinstance(record, dict) else None
         if isinstance(size, int) and not isinstance(size, bool) and size > 0:
             sizes.append(size)
     return max(sizes, default=None)
+
+
+def check_not_lost(batch_dir: Path) -> None:
+    """RecordMismatch (one line, saying how to write it again) for a batch directory without
+    batch.json whose trials record a manifest (experiments/manifest.py): every version that
+    wrote manifests wrote batch.json too, so its record was lost (or the folder was put
+    together by hand), and the reference size its profile set is unknown; only a batch from
+    before records is reported at the study's size without one."""
+    if (batch_dir / BATCH_FILE).exists() or not batch_dir.is_dir():
+        return
+    for trial_dir in sorted(batch_dir.iterdir()):
+        if is_trial_dir(trial_dir) and any((trial_dir / MANIFEST_DIR).glob("files-*.json")):
+            raise RecordMismatch(
+                f"{batch_dir} has no {BATCH_FILE}, though its trials were written by a version "
+                f"that writes one ({trial_dir.name} records a manifest of its files, which no "
+                "earlier version did), so the reference size its profile set is unknown: rerun "
+                "`playroom batch` into it with the profile or config that made it (complete "
+                f"trials are kept, not run again, and {BATCH_FILE} is written again), or give "
+                "--study-reference-commands"
+            )
 
 
 # The trial settings a record fixes for every trial (a record field -> config.json's "trial").
@@ -91,8 +115,10 @@ def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path])
     """RecordMismatch (one line) naming the trials of `batch_dir` whose config.json (or
     evaluation) disagrees with the batch's record (batch.json): a batch rerun into the same
     directory with other settings, before `playroom batch` refused it, left such a mix. A
-    batch without a record is not checked (one written before batch.json); a record that
-    cannot be read is refused (`read_batch_record`)."""
+    batch without a record is not checked (one written before batch.json, or a folder of
+    trials run one by one); a record that cannot be read is refused (`read_batch_record`).
+    Each eval.json is read checked (experiments/eval_record.py): one that is not as recorded
+    is left to the reader that needs it to name, not taken for another batch's."""
     path = Path(batch_dir) / BATCH_FILE
     record = read_batch_record(batch_dir)
     if record is None:
@@ -100,13 +126,12 @@ def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path])
     found = []
     for trial_dir in trial_dirs:
         try:
-            config = storage.read_json(trial_dir / CONFIG_FILE)
-            summary = storage.read_json(trial_dir / EVAL_FILE)
-        except (storage.CorruptFileError, OSError):
+            config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+            trial = config["trial"]
+            summary = eval_record.read_evaluation(trial_dir, config, "", warn=False)
+        except (storage.CorruptFileError, OSError, KeyError, TypeError, AttributeError):
             continue  # the reader that needs the file says what is wrong with it
-        trial = with_added_settings(config).get("trial") if isinstance(config, dict) else None
-        placements = summary.get("n_placements") if isinstance(summary, dict) else None
-        why = _disagreement(record, trial, placements) if isinstance(trial, dict) else None
+        why = _disagreement(record, trial, summary.get("n_placements"))
         if why is not None:
             found.append((trial_dir.name, why))
     if found:

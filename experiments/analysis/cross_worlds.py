@@ -7,7 +7,8 @@ worlds).
 A trial's test in a world is its evaluation in that eval world (`DIR/eval-in-WORLD/eval.json`,
 `playroom eval DIR --world WORLD`, experiments/eval_worlds.py) or, where that world is the
 trial's own (`eval_worlds.own_world`), its own evaluation (eval.json).
-Each evaluation's tables are checked against the sizes and SHA-256 its eval.json lists.
+Each evaluation's eval.json is checked against its own checksum and the trial's config.json
+(experiments/eval_record.py), its tables against the sizes and SHA-256 it lists.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import manifest, storage
+from experiments import eval_record, manifest, storage
 from experiments.analysis.logs import trial_dirs
 from experiments.config_file import with_added_settings
 from experiments.eval_worlds import own_world
@@ -54,10 +55,19 @@ def tested_in(trial_dir: Path, world: str, check: bool = True) -> tuple[dict, st
         )
     if not (folder / EVAL_FILE).exists():
         raise MissingTestError(f"{trial_dir.name} is not evaluated: `playroom eval {trial_dir}`")
-    summary = storage.read_json(folder / EVAL_FILE)
+    return checked_summary(trial_dir, folder, config, check), which
+
+
+def checked_summary(trial_dir: Path, folder: Path, config: dict, check: bool = True) -> dict:
+    """The eval.json of a trial's evaluation in `folder` (the trial directory or one of its
+    eval-in-WORLD/), checked against itself and the trial's `config` (experiments/
+    eval_record.py) and, if `check`, each table it lists against it. storage.CorruptFileError
+    (one line naming the file and what to do) otherwise."""
+    remedy = eval_record.evaluation_remedy(trial_dir, folder)
+    summary = eval_record.read_evaluation(folder, config, remedy)
     for name in EVALUATION_TABLES if check else ():
         manifest.read_evaluation_file(folder, name, summary)
-    return summary, which
+    return summary
 
 
 def cross_table(batches: dict[str, str | os.PathLike], worlds: tuple[str, ...]) -> pd.DataFrame:

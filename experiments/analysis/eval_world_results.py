@@ -6,7 +6,8 @@ evaluation in eval world `world` (experiments/eval_worlds.py) instead of its own
 words, the study's tests), so that agents of both backends can be compared in one test world.
 A trial whose own world that is reads its own evaluation (eval.json in the trial directory);
 the others read `eval-in-<world>/`, refused in one line (ReportError) when missing, damaged
-(a table whose size or checksum is not what its eval.json lists), or made for another world
+(an eval.json not as it recorded itself or of another trial, experiments/eval_record.py; a
+table whose size or checksum is not what its eval.json lists), or made for another world
 than the one declared now; the message names the command that makes it. The trials' rows say
 where they were tested (`eval_world`, `tested_grasp`, `tested_in_own_world`).
 """
@@ -18,7 +19,7 @@ import json
 import os
 from pathlib import Path
 
-from experiments import manifest, storage
+from experiments import eval_record, manifest, storage
 from experiments.analysis.results import BatchResults, ReportError
 from experiments.analysis.results import collect as collect_own
 from experiments.config_file import with_added_settings
@@ -114,9 +115,7 @@ def _checked(trial_dir: Path, config: dict, world: str) -> Path:
     if folder == trial_dir:  # its own evaluation: results.collect checks it as ever
         return folder
     try:
-        summary = storage.read_json(folder / EVAL_FILE)
-        if not isinstance(summary, dict):
-            raise storage.CorruptFileError(f"{folder / EVAL_FILE} is not an evaluation summary")
+        summary = eval_record.read_evaluation(folder, config, remedy(trial_dir, world))
         check_evaluation(trial_dir, config, world, summary)
     except storage.CorruptFileError as exc:
         raise ReportError(" ".join(str(exc).split())) from None

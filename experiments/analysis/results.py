@@ -22,7 +22,7 @@ from typing import Any
 
 import pandas as pd
 
-from experiments import backend_record, manifest, storage
+from experiments import backend_record, eval_record, manifest, storage
 from experiments.analysis.batch_checks import BatchMismatch, check_group, group_label, shared_config
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
 from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
@@ -140,6 +140,18 @@ def _read_json(path: Path) -> Any:
         raise ReportError(str(exc)) from None
 
 
+def read_summary(trial_dir: Path, config: dict, folder: Path | None = None) -> dict:
+    """The eval.json of a trial's evaluation in `folder` (default: its own, in the trial
+    directory), checked against itself and the trial's `config` (experiments/eval_record.py);
+    ReportError (one line naming the file and what to do) otherwise."""
+    folder = trial_dir if folder is None else folder
+    remedy = eval_record.evaluation_remedy(trial_dir, folder)
+    try:
+        return eval_record.read_evaluation(folder, config, remedy)
+    except storage.CorruptFileError as exc:
+        raise ReportError(" ".join(str(exc).split())) from None
+
+
 def _read_table(path: Path, summary: dict) -> pd.DataFrame | None:
     """A table of a trial's evaluation, checked against its eval.json (`summary`); None for a
     table that an evaluation from before it existed lacks."""
@@ -196,20 +208,16 @@ def check_out_dir(out_dir: Path) -> None:
         raise ReportError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
 
 
-def _check_group(label: str, dirs: list[Path], configs: list[dict], evals: list[dict]) -> None:
-    """Every setting but the seed agrees; seeds are distinct (experiments/analysis/
-    batch_checks.py); every trial was evaluated at its end on the same number of placements."""
-    try:
-        check_group(label, dirs, configs)
-    except BatchMismatch as exc:
-        raise ReportError(str(exc)) from None
-    for d, config, summary in zip(dirs, configs, evals, strict=True):
+def _check_evaluations(label: str, trials: list[tuple[Path, dict, dict]]) -> None:
+    """Every trial of group `label` (directory, config, eval.json) was evaluated at its end on
+    the same number of placements (its settings were checked before: `check_group`)."""
+    for d, config, summary in trials:
         if summary.get("evaluated_at_iteration") != config["trial"]["iterations"]:
             raise ReportError(
                 f"{d.name} was evaluated at iteration {summary.get('evaluated_at_iteration')} "
                 f"of {config['trial']['iterations']}: finish the trial and evaluate it again"
             )
-    placements = {s.get("n_placements") for s in evals}
+    placements = {summary.get("n_placements") for _, _, summary in trials}
     if len(placements) > 1:
         raise ReportError(
             f"trials of group {label} were evaluated on different numbers of placements "
@@ -335,31 +343,27 @@ def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Pat
         raise ReportError(str(exc)) from None
     configs = [_read_json(d / CONFIG_FILE) for d in dirs]
     configs = [with_added_settings(c) if isinstance(c, dict) else c for c in configs]
-    evals = [_read_json(eval_dir(d) / EVAL_FILE) for d in dirs]
     for d, config in zip(dirs, configs, strict=True):
         if not isinstance(config, dict) or not {"grasp", "babbling", "seed", "iterations"} <= set(
             config.get("trial", {})
         ):
             raise ReportError(f"{d / CONFIG_FILE} lacks the trial's grasp/babbling/seed")
-    for d, summary in zip(dirs, evals, strict=True):
-        if not isinstance(summary, dict):
-            raise ReportError(f"{d / EVAL_FILE} is not an evaluation summary")
     # Babbling joins the label only when it tells groups apart, to keep labels short.
     mixed = len({c["trial"]["babbling"] for c in configs}) > 1
     labels = [group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
+    groups = {lab: [i for i, x in enumerate(labels) if x == lab] for lab in sorted(set(labels))}
+    for label, members in groups.items():  # the settings first: what differs is named
+        try:  # every setting but the seed agrees; seeds are distinct
+            check_group(label, [dirs[i] for i in members], [configs[i] for i in members])
+        except BatchMismatch as exc:
+            raise ReportError(str(exc)) from None
     group_configs: dict[str, dict] = {}
-    for label in sorted(set(labels)):
-        members = [i for i, lab in enumerate(labels) if lab == label]
-        _check_group(
-            label,
-            [dirs[i] for i in members],
-            [configs[i] for i in members],
-            [evals[i] for i in members],
-        )
-        group_configs[label] = shared_config(configs[members[0]])
-
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", manifest.UncheckedTrialWarning)
+        evals = [read_summary(d, c, eval_dir(d)) for d, c in zip(dirs, configs, strict=True)]
+        for label, members in groups.items():
+            _check_evaluations(label, [(dirs[i], configs[i], evals[i]) for i in members])
+            group_configs[label] = shared_config(configs[members[0]])
         rows = [
             _trial_rows(d, config, summary, label, eval_dir(d))
             for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)

@@ -28,10 +28,10 @@ from scipy import stats
 
 from experiments import storage
 from experiments.analysis import trial_tests
-from experiments.analysis.cross_worlds import RINGS, STRATEGIES, tested_in
+from experiments.analysis.cross_worlds import RINGS, STRATEGIES, checked_summary, tested_in
 from experiments.analysis.logs import trial_dirs
-from experiments.file_names import EVAL_FILE, EVALUATION_TABLES
-from experiments.manifest import read_evaluation_file
+from experiments.config_file import with_added_settings
+from experiments.file_names import CONFIG_FILE
 
 OWN = "own"
 MEASURES = ("competence_all", "competence_ring1", "competence_ring2", "competence_ring3")
@@ -49,14 +49,14 @@ def _numbers(summary: dict) -> dict[str, float]:
 def evaluations(conditions: dict[str, Path], check: bool = True) -> pd.DataFrame:
     """One row per (condition, seed, tested): `tested` is "own" (the trial's own evaluation) or
     a test world it was tested in (its cross-evaluation, or its own where it learned there).
-    Each evaluation's tables are checked against its eval.json unless not `check` (copies of
-    eval.json without their tables, said on the command line)."""
+    Each evaluation's eval.json is checked (experiments/eval_record.py), and its tables against
+    it unless not `check` (copies of eval.json without their tables, said on the command
+    line)."""
     rows = []
     for condition, batch_dir in conditions.items():
         for trial in trial_dirs(batch_dir):
-            summary = storage.read_json(trial / EVAL_FILE)
-            for name in EVALUATION_TABLES if check else ():
-                read_evaluation_file(trial, name, summary)
+            config = with_added_settings(storage.read_json(trial / CONFIG_FILE))
+            summary = checked_summary(trial, trial, config, check)
             keys = {"condition": condition, "seed": int(summary["seed"])}
             rows.append({**keys, "tested": OWN, **_numbers(summary)})
             for world in WORLDS:

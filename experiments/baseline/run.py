@@ -203,5 +203,5 @@ def evaluate_baseline(
         actor, actor, room, evaluation, summary_config(settings), best, settings.steps, progress
     )
     summary["learner"] = {"name": LEARNER, "algorithm": ALGORITHM, "replay_buffer": REPLAY_BUFFER}
-    storage.write_files(out, evaluation_files(summary, tables))
+    storage.write_files(out, evaluation_files(summary, tables, record["trial"]))
     return summary

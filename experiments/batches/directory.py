@@ -13,10 +13,10 @@ import dataclasses
 import json
 from pathlib import Path
 
-from experiments import storage
+from experiments import eval_record, storage
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.config_file import with_added_settings
-from experiments.file_names import BATCH_FILE, CONFIG_FILE, EVAL_FILE
+from experiments.file_names import BATCH_FILE, CONFIG_FILE
 from experiments.log_layout import is_trial_dir
 from experiments.run.trial_config import full_config
 
@@ -114,11 +114,9 @@ def _difference(trial_dir: Path, wanted: dict, placements: int) -> str | None:
         k, a, b = differences[0]
         return f"{trial_dir.name} was run with {k}={_shown(a)}, this batch runs {_shown(b)}"
     try:  # an evaluation at the trial's end would be kept as the batch's (runner.is_complete)
-        summary = storage.read_json(trial_dir / EVAL_FILE)
-    except (OSError, storage.CorruptFileError):
-        return None
-    if not isinstance(summary, dict):
-        return None
+        summary = eval_record.read_evaluation(trial_dir, held, "", warn=False)
+    except (OSError, KeyError, TypeError, storage.CorruptFileError):
+        return None  # not kept: evaluated again
     at, n = summary.get("evaluated_at_iteration"), summary.get("n_placements")
     if at == wanted["trial"]["iterations"] and n is not None and n != placements:
         return (

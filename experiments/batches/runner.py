@@ -29,7 +29,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from experiments import manifest, storage
+from experiments import eval_record, manifest, storage
 from experiments.analysis.eval_world_results import check_evaluation
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches import worker_check, workers
@@ -49,7 +49,6 @@ from experiments.file_names import (
     BATCH_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
-    EVAL_FILE,
     EVALUATION_TABLES,
     TIMING_FILE,
     eval_world_dir,
@@ -96,8 +95,9 @@ def is_complete(trial_dir: Path) -> bool:
         config = storage.read_json(trial_dir / CONFIG_FILE)
         # Read whole, with the memory segments it names (a damaged one is run again).
         _, meta = memory_segments.read_checkpoint(trial_dir / CHECKPOINT_FILE)
-        summary = storage.read_json(trial_dir / EVAL_FILE)
-        if not meta.get("finished") or not isinstance(summary, dict):
+        # As recorded and this trial's (eval_record), else evaluated again.
+        summary = eval_record.read_evaluation(trial_dir, config, "", warn=False)
+        if not meta.get("finished"):
             return False
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
@@ -107,7 +107,7 @@ def is_complete(trial_dir: Path) -> bool:
         check_files(trial_dir, meta, with_added_settings(config))
         for name in EVALUATION_TABLES:
             manifest.read_evaluation_file(trial_dir, name, summary)
-    except (OSError, KeyError, storage.CorruptFileError, TrialError):
+    except (OSError, KeyError, TypeError, storage.CorruptFileError, TrialError):
         return False
     return True
 
@@ -121,9 +121,9 @@ def eval_world_complete(trial_dir: Path, world: str, placements: int) -> bool:
         config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
         if own_world(config, world):
             return True
-        summary = storage.read_json(trial_dir / eval_world_dir(world) / EVAL_FILE)
+        summary = eval_record.read_evaluation(trial_dir / eval_world_dir(world), config, "", False)
         meta = storage.read_meta(trial_dir / CHECKPOINT_FILE)
-        if not isinstance(summary, dict) or summary.get("n_placements") != placements:
+        if summary.get("n_placements") != placements:
             return False
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
@@ -164,7 +164,7 @@ def _own_part_complete(path: Path, placements: int) -> dict | None:
     `placements` placements, else None."""
     if not is_complete(path):
         return None
-    summary = storage.read_json(path / EVAL_FILE)
+    summary = eval_record.read_evaluation(path, storage.read_json(path / CONFIG_FILE), "", False)
     return summary if summary.get("n_placements") == placements else None
 
 

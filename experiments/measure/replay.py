@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments import manifest, storage
+from experiments import eval_record, manifest, storage
 from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
 from experiments.measure.evaluation import EvaluationSettings, goal_trajectory, placements
 from experiments.run.trial_checks import load_trial
@@ -95,7 +95,8 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
         dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / EVAL_FILE).exists())
         for trial_dir in dirs[:n_trials]:
             config, agent, room, _ = load_trial(trial_dir)
-            summary = storage.read_json(trial_dir / EVAL_FILE)
+            remedy = eval_record.evaluation_remedy(trial_dir, trial_dir)
+            summary = eval_record.read_evaluation(trial_dir, config, remedy)
             # The evaluation's scenes (its placements), and the random command it played on
             # each of them beside the replays.
             table = replay_table(agent, room, EvaluationSettings(int(summary["n_placements"])))

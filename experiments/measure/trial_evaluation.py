@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import manifest, provenance, storage
+from experiments import eval_record, manifest, provenance, storage
 from experiments.eval_worlds import OWN, EvalWorldError, own_world, world_record
 from experiments.file_names import (
     COMPETENCE_FILE,
@@ -40,7 +40,7 @@ from experiments.measure.study_measure import (
     study_tests_of,
 )
 from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.trial_checks import is_litter, load_trial, remove_litter
+from experiments.run.trial_checks import load_trial, remove_litter
 from experiments.run.trial_files import TrialError, TrialLocked, fresh_trial_parts
 from sim import Playroom
 
@@ -86,11 +86,6 @@ def evaluate_trial(
             storage.check_writable(out_dir)
         except OSError as exc:
             raise TrialError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
-        litter = [p.name for p in sorted(out_dir.glob(".*.tmp")) if is_litter(p.name)]
-        for name in litter:  # under the lock, as for the trial's own files
-            (out_dir / name).unlink(missing_ok=True)
-        if litter and notify is not None:
-            notify(f"removed {len(litter)} temporary file(s) of a killed writer in {out_dir}")
         summary, tables = measured(
             LearnerActor(agent),
             StudyLearnerActor(agent),
@@ -103,7 +98,7 @@ def evaluate_trial(
         )
         if out_dir != trial_dir:
             summary["eval_world"] = world_record(config, world)
-        files = evaluation_files(summary, tables)
+        files = evaluation_files(summary, tables, config)
         storage.write_files(out_dir, files)
     finally:
         lock.release()
@@ -177,12 +172,14 @@ def measured(
     return summary, tables
 
 
-def evaluation_files(summary: dict, tables: dict[str, bytes]) -> dict[str, bytes]:
-    """The files of an evaluation, eval.json last: it vouches for the tables
-    (storage.write_files). eval.json lists the tables with their sizes and checksums, so that a
-    reader refuses a table lost, damaged or left from another evaluation. A word's best
-    distance (and so a median) is infinite until the learner's first voice movement: eval.json,
+def evaluation_files(summary: dict, tables: dict[str, bytes], config: dict) -> dict[str, bytes]:
+    """The files of an evaluation of the trial whose config.json is `config`, eval.json last:
+    it vouches for the tables (storage.write_files). eval.json lists the tables with their
+    sizes and checksums, so that a reader refuses a table lost, damaged or left from another
+    evaluation, and records its own checksum and the trial's identity, so that a reader
+    refuses it damaged or another trial's (experiments/eval_record.py). A word's best distance
+    (and so a median) is infinite until the learner's first voice movement: eval.json,
     standard JSON, holds null for it (experiments/analysis/results.py reads it back as
     infinity); `summary` itself keeps the numbers."""
     summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(tables)
-    return {**tables, EVAL_FILE: storage.json_bytes(storage.finite_or_null(summary))}
+    return {**tables, EVAL_FILE: eval_record.evaluation_json(summary, config)}

@@ -25,9 +25,7 @@ from experiments.file_names import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
-    LOG_DIR,
     LOG_KINDS,
-    MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
 from experiments.log_layout import (
@@ -300,7 +298,8 @@ def is_litter(name: str) -> bool:
 
 def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     """Remove the temporary files that writers killed mid-write (storage.write_bytes) left in a
-    trial directory, its memory/ and its log/; returns their names (relative to the directory).
+    trial directory, wherever they lie in it (its memory/, log/, manifest/, an eval world's
+    folder...); returns their paths relative to the directory.
 
     Called under the directory's lock: every writer of the trial's own files (run, eval, a
     batch task) holds it, so such a file there was left by a dead writer. A live process is
@@ -309,12 +308,10 @@ def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
     files leave temporary files out)."""
     trial_dir = Path(trial_dir)
     removed = []
-    log = trial_dir / LOG_DIR
-    for folder in (trial_dir, trial_dir / MEMORY_DIR, log, *(log / kind for kind in LOG_KINDS)):
-        for path in sorted(folder.glob(".*.tmp")):
-            if is_litter(path.name):
-                path.unlink(missing_ok=True)
-                removed.append(str(path.relative_to(trial_dir)))
+    for path in sorted(trial_dir.rglob(".*.tmp")):
+        if is_litter(path.name):
+            path.unlink(missing_ok=True)
+            removed.append(path.relative_to(trial_dir).as_posix())
     return removed
 
 

@@ -5,9 +5,13 @@ refused in one line. The runs here are written by the evaluation a baseline's ru
 
 from __future__ import annotations
 
+import shutil
+
 import pytest
 from baseline_runs import write_run
+from bit_flips import flip_number
 
+from experiments import storage
 from experiments.analysis.baseline_results import collect_baselines
 from experiments.analysis.results import ReportError
 from experiments.baseline.settings import BaselineSettings, run_name
@@ -51,3 +55,16 @@ def test_an_unfinished_or_damaged_run_is_refused_in_one_line(runs, tmp_path):
         collect_baselines(runs / name)  # a run, not a folder of runs
     for caught in (damaged, unfinished):
         assert "\n" not in str(caught.value)
+
+
+def test_a_damaged_or_another_runs_eval_json_is_refused_in_one_line(runs):
+    first, other = (runs / run_name(BaselineSettings(steps=30, seed=s)) for s in (0, 3))
+    path = other / EVAL_FILE
+    ring1 = storage.read_json(path)["competence"]["ring1"]
+    flip_number(path, "ring1", ring1)  # still JSON, another number
+    with pytest.raises(ReportError, match=f"{path} is damaged") as damaged:
+        collect_baselines(runs)
+    assert "rl-baseline" in str(damaged.value) and "\n" not in str(damaged.value)
+    shutil.copyfile(first / EVAL_FILE, path)  # another run's, intact
+    with pytest.raises(ReportError, match=f"{path} is the evaluation of another trial"):
+        collect_baselines(runs)

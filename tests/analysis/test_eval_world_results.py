@@ -7,12 +7,15 @@ from __future__ import annotations
 import shutil
 
 import pytest
+from bit_flips import flip_number
+from old_trials import rewritten_evaluation
 
 from experiments import storage
 from experiments.analysis.eval_world_results import collect
 from experiments.analysis.results import ReportError
 from experiments.analysis.results import collect as collect_own
-from experiments.file_names import COMPETENCE_FILE, EVAL_FILE, eval_world_dir
+from experiments.batches.runner import eval_world_complete
+from experiments.file_names import COMPETENCE_FILE, CONFIG_FILE, EVAL_FILE, eval_world_dir
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.settings import TrialSettings
@@ -65,7 +68,7 @@ def test_trials_lacking_the_evaluation_are_named_with_the_command_that_makes_it(
     assert "physical-random-seed0000" in message and "--world kinematic" in message
 
 
-@pytest.mark.parametrize("damage", ["table", "world"])
+@pytest.mark.parametrize("damage", ["table", "eval.json", "world"])
 def test_a_damaged_or_foreign_evaluation_is_refused_in_one_line(batch, tmp_path, damage):
     copy = shutil.copytree(batch, tmp_path / "batch")
     folder = copy / "kinematic-random-seed0000" / eval_world_dir("physical")
@@ -73,15 +76,19 @@ def test_a_damaged_or_foreign_evaluation_is_refused_in_one_line(batch, tmp_path,
         data = bytearray((folder / COMPETENCE_FILE).read_bytes())
         data[len(data) // 2] ^= 0xFF
         (folder / COMPETENCE_FILE).write_bytes(bytes(data))
+    elif damage == "eval.json":  # still JSON, another number
+        ring1 = storage.read_json(folder / EVAL_FILE)["competence"]["ring1"]
+        flip_number(folder / EVAL_FILE, "ring1", ring1)
     else:  # made for another declaration of the world than today's
-        summary = storage.read_json(folder / EVAL_FILE)
-        summary["eval_world"]["world"]["push_objects"] = False
-        storage.write_json(folder / EVAL_FILE, summary)
+        config = storage.read_json(folder.parent / CONFIG_FILE)
+        rewritten_evaluation(folder, config, _declared_without_pushing)
     with pytest.raises(ReportError) as caught:
         collect(copy, "physical")
     message = str(caught.value)
     assert "\n" not in message and str(folder) in message and "--world physical" in message
-    assert ("damaged" if damage == "table" else "as declared now") in message
+    said = {"table": f"{COMPETENCE_FILE} is damaged", "eval.json": f"{EVAL_FILE} is damaged"}
+    assert said.get(damage, "as declared now") in message
+    assert not eval_world_complete(folder.parent, "physical", 1)  # a batch rerun makes it again
 
 
 def test_an_unknown_world_is_refused():
@@ -91,11 +98,19 @@ def test_an_unknown_world_is_refused():
 
 def test_a_world_setting_added_since_does_not_make_an_evaluation_stale(batch, tmp_path):
     copy = shutil.copytree(batch, tmp_path / "batch")
-    path = copy / "kinematic-random-seed0000" / eval_world_dir("physical") / EVAL_FILE
-    summary = storage.read_json(path)
-    del summary["eval_world"]["world"]["voice"]  # as if written before it existed
-    storage.write_json(path, summary)
+    trial = copy / "kinematic-random-seed0000"
+    config = storage.read_json(trial / CONFIG_FILE)
+    # As if written before the setting existed.
+    rewritten_evaluation(trial / eval_world_dir("physical"), config, _without_voice)
     assert len(collect(copy, "physical").trials) == 2
+
+
+def _declared_without_pushing(summary: dict) -> None:
+    summary["eval_world"]["world"]["push_objects"] = False
+
+
+def _without_voice(summary: dict) -> None:
+    del summary["eval_world"]["world"]["voice"]
 
 
 def test_the_cross_world_table_reads_each_trial_as_each_world_tested_it(batch, tmp_path):

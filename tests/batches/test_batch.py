@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from experiments import storage
+from experiments import eval_record, storage
 from experiments.analysis.logs import read_log
 from experiments.batches import scheduler as scheduler_module
 from experiments.batches.runner import is_complete, run_batch
@@ -181,7 +181,8 @@ def test_two_batches_with_the_same_trial_names_on_one_scheduler_stay_apart(tmp_p
         trial = tmp_path / batch / name
         assert is_complete(trial), batch
         assert storage.read_json(trial / "config.json")["trial"]["preset"] == spec.preset
-        written = storage.read_json(trial / "eval.json")
+        config = storage.read_json(trial / "config.json")
+        written = eval_record.read_evaluation(trial, config, "")  # as every reader reads it
         assert results[name] == {**written, "wall_seconds": results[name]["wall_seconds"]}
 
 

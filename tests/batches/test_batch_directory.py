@@ -133,6 +133,27 @@ def test_trials_that_the_batch_would_not_run_are_named_without_a_record(made, tm
         check_directory(dataclasses.replace(spec, eval_placements=2), batch)
 
 
+def test_f3_a_lost_record_is_refused_by_reports_and_written_again_by_the_same_batch(
+    made, tmp_path, capsys, monkeypatch
+):
+    batch = _copy(made, tmp_path)
+    record = (batch / BATCH_FILE).read_bytes()
+    (batch / BATCH_FILE).unlink()  # its trials record manifests: a batch of this version's
+    page = tmp_path / "page"
+    assert main(["report", str(batch), "--out", str(page)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{batch} has no {BATCH_FILE}" in err[0], err
+    assert "rerun `playroom batch` into it with the profile or config" in err[0]
+    assert not page.exists()  # not reported at the study's reference size instead
+    # What the line says to do: the same batch again writes the record and runs nothing.
+    trials = _files(batch)
+    monkeypatch.setattr(dask_scheduler, "connect", _no_cluster)
+    assert main(["batch", "--config", str(made[1]), "--out", str(batch)]) == 0
+    assert "all 2 trials already complete" in capsys.readouterr().out
+    assert (batch / BATCH_FILE).read_bytes() == record
+    assert {k: v for k, v in _files(batch).items() if k != BATCH_FILE} == trials
+
+
 def test_an_unreadable_record_is_refused_not_overwritten(made, tmp_path):
     batch = _copy(made, tmp_path)
     (batch / BATCH_FILE).write_text("{")

@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from old_trials import as_before_manifests
+from old_trials import as_before_eval_checksums, as_before_manifests
 from page_checks import check_explained
 from summary_checks import check_summary
 
+from experiments import storage
 from experiments.analysis.curves import curve_rows, tool_numbers
 from experiments.analysis.results import ReportError, collect
 from experiments.analysis.stats import (
@@ -323,9 +324,14 @@ def test_labels_and_paths_reach_the_page_as_text_not_markup(batches, tmp_path):
     batch = _copy_batch(batches, tmp_path / "<b>batch")
     for config_path in batch.glob("*/config.json"):
         as_before_manifests(config_path.parent)  # edited by hand below: as an older trial
+        as_before_eval_checksums(config_path.parent)  # and its evaluation
         config = json.loads(config_path.read_text())
         config["trial"]["grasp"] = "<script>alert(1)</script>"
         config_path.write_text(json.dumps(config))
+        summary = storage.read_json(config_path.parent / EVAL_FILE)
+        storage.write_json(
+            config_path.parent / EVAL_FILE, {**summary, "grasp": "<script>alert(1)</script>"}
+        )
         # Log chunks carry their trial's identity: this trial's chunks take the new one.
         for chunk in config_path.parent.glob("log/*/*.parquet"):
             table = pd.read_parquet(chunk)

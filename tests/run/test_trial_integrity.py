@@ -22,7 +22,10 @@ from experiments.file_names import (
     EVAL_FILE,
     LOCK_FILE,
     LOG_DIR,
+    MANIFEST_DIR,
     PREVIOUS_CHECKPOINT_FILE,
+    eval_world_dir,
+    manifest_name,
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
@@ -237,6 +240,28 @@ def test_temporary_files_of_killed_writers_are_removed_and_never_results(base, t
     assert stale and all(not name.endswith(".tmp") for name in stale)
     assert EVAL_FILE in stale
     assert any("temporary file" in n and f".{CHECKPOINT_FILE}.{dead}.tmp" in n for n in notices)
+
+
+@pytest.mark.parametrize("writer", ["resume", "eval"])
+def test_f5_a_killed_writers_temporary_file_is_removed_wherever_it_lies(base, tmp_path, writer):
+    out = _copy(base, tmp_path)
+    dead = _dead_pid()
+    (out / eval_world_dir("physical")).mkdir()
+    litter = [
+        out / MANIFEST_DIR / f".{manifest_name(TOTAL)}.{dead}.tmp",  # a checkpoint's manifest
+        out / eval_world_dir("physical") / f".{EVAL_FILE}.{dead}.tmp",  # a cross-evaluation's
+        out / f".write-test.{dead}.tmp",  # the probe of whether the directory can be written
+    ]
+    for path in litter:
+        path.write_bytes(b"half a file")
+    notices: list[str] = []
+    if writer == "resume":
+        run_trial(out, SETTINGS, resume=True, progress=False, notify=notices.append)
+    else:
+        evaluate_trial(out, EvaluationSettings(n_placements=1), notify=notices.append)
+    assert not any(path.exists() for path in litter)
+    removed = f"{MANIFEST_DIR}/.{manifest_name(TOTAL)}.{dead}.tmp"
+    assert any("temporary file" in n and removed in n for n in notices), notices
 
 
 def test_a_new_trials_folder_left_by_a_killed_first_write_is_started_again(tmp_path):
