@@ -80,6 +80,10 @@ def _wait_for(lines: queue.Queue, pattern: str, seen: list[str]) -> re.Match:
             return found
 
 
+def _interruptible() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.slow  # starts a scheduler and two jobs of worker processes: ~10 s
 def test_the_jobs_workers_join_the_printed_scheduler_and_ctrl_c_cancels_them(tmp_path):
     from distributed import Client
@@ -92,6 +96,9 @@ def test_the_jobs_workers_join_the_printed_scheduler_and_ctrl_c_cancels_them(tmp
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         env={**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ['PATH']}",
              "PYTHONPATH": str(ROOT)},
+        # Ctrl-C as a terminal gives it: pytest-xdist's workers ignore SIGINT, and a child
+        # inherits that (Python then installs no KeyboardInterrupt for it).
+        preexec_fn=_interruptible,
     )  # fmt: skip
     lines: queue.Queue = queue.Queue()
     threading.Thread(target=_lines, args=(command.stdout, lines), daemon=True).start()
