@@ -77,6 +77,23 @@ def write_bytes(path: Path, data: bytes) -> None:
         raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from exc
 
 
+def keep_copy(path: Path, copy: Path) -> None:
+    """`path`'s file also at `copy`, replacing it atomically, `path` untouched: a hard link
+    where the filesystem has them (no bytes copied), else a copy through a temporary file."""
+    tmp = copy.with_name(f".{copy.name}.{os.getpid()}.tmp")
+    try:
+        tmp.unlink(missing_ok=True)
+        try:
+            os.link(path, tmp)
+        except OSError:  # a filesystem without hard links
+            tmp = _write_temporary(copy, path.read_bytes())
+        os.replace(tmp, copy)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise WriteError(exc.errno, exc.strerror or str(exc), str(copy)) from exc
+
+
 def write_files(directory: Path, files: dict[str, bytes]) -> list[Path]:
     """Files written into `directory` (created if missing) as one unit: each is first written
     to a temporary file beside it, and only when all are on disk are they renamed into place,

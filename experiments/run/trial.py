@@ -149,8 +149,10 @@ class Trial:
         }
         newest = self.dir / CHECKPOINT_FILE
         if newest.exists():
-            # Killed between these two lines, the trial still has the previous checkpoint.
-            os.replace(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
+            # Kept as the previous one by a second name, not moved: at every moment the trial
+            # has a whole checkpoint.npz (moved, there was none while the new one was written,
+            # and a writer killed then left only the previous one).
+            storage.keep_copy(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
         storage.write_arrays(newest, arrays, meta)
         self.memory = memory
         self.manifest_pointer, self.unrecorded = pointer, []
