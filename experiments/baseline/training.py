@@ -28,7 +28,14 @@ from sim.process_environment import environment_kept
 with environment_kept():
     import gymnasium
 
-from experiments.baseline.settings import ALGORITHM, POLICY, REPLAY_BUFFER, BaselineError
+from experiments.baseline.settings import (
+    ALGORITHM,
+    EPISODE_MOVEMENTS,
+    MOTOR,
+    POLICY,
+    REPLAY_BUFFER,
+    BaselineError,
+)
 from models.layout import block_slice
 from sim.caregiver import WordAssignment
 from sim.config import WorldConfig
@@ -114,7 +121,13 @@ def make_env(
     import sim.envs  # noqa: F401  (registers the ids)
 
     env = gymnasium.make(
-        goal_id(grasp), goal=f"toy{toy}", grasp=grasp, config=world, voice_config=voice
+        goal_id(grasp),
+        goal=f"toy{toy}",
+        motor=MOTOR,
+        movements=EPISODE_MOVEMENTS,
+        grasp=grasp,
+        config=world,
+        voice_config=voice,
     )
     return SameWords(env, words)
 
