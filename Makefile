@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline clean
+.PHONY: install install-rl lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -164,6 +164,10 @@ $(RL_INSTALLED): $(INSTALLED)
 	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --extra-index-url $(TORCH_INDEX) torch
 	$(BIN)/python -m pip install --quiet --constraint $(LOCK) -e ".[rl]"
 	touch $(RL_INSTALLED)
+
+## install-rl: the `rl` extra (stable-baselines3, torch's CPU build, MoviePy) into .venv, at the
+## versions of constraints.txt (its size and time: docs/rl-baseline.md)
+install-rl: $(RL_INSTALLED)
 
 ## rl-baseline: Model Babbling against deep RL on the same test, given the same movements: the
 ## batch of experiments/batches/rl-baseline/comparison.json (both backends, 8 seeds x 20000

@@ -42,7 +42,7 @@ from sim.config import WorldConfig
 from sim.envs.versions import GOAL_VARIANTS
 from sim.vocal.config import VoiceConfig
 
-RL_EXTRA = 'pip install -e ".[rl]"'
+RL_EXTRA = "make install-rl"
 _SOUND = block_slice("sound")
 # The SAC settings that baseline's training.json records (their values are the library's).
 RECORDED = (
@@ -69,7 +69,7 @@ def rl_library() -> Any:
     except ImportError as exc:
         raise BaselineError(
             f"the RL baseline needs the `rl` extra (stable-baselines3, torch): {RL_EXTRA} "
-            f"(`make test-slow` installs it into .venv); {exc}"
+            f"(stable-baselines3 and torch's CPU build into .venv); {exc}"
         ) from None
     return stable_baselines3
 
