@@ -16,7 +16,7 @@ from typing import Any
 import gymnasium
 import numpy as np
 
-from experiments.baseline.control_settings import sac_arguments
+from experiments.baseline.control_settings import CONTROL, sac_arguments
 from experiments.baseline.training import rl_library
 
 DictObs = dict[str, np.ndarray]
@@ -25,9 +25,10 @@ Act = Callable[[DictObs], np.ndarray]
 SATURATED = 0.99
 
 
-def sac_her(env: gymnasium.Env, seed: int, threads: int) -> Any:
-    """SAC with HerReplayBuffer and the control's settings, on the CPU, on `env` (one goal
-    environment; its episodes drawn from the model's seed)."""
+def sac_her(env: gymnasium.Env, seed: int, threads: int, settings: str = CONTROL) -> Any:
+    """SAC with HerReplayBuffer and the control's settings (or stable-baselines3's defaults:
+    control_settings.py `sac_arguments`), on the CPU, on `env` (one goal environment; its
+    episodes drawn from the model's seed)."""
     sb3 = rl_library()
     import torch
 
@@ -39,7 +40,7 @@ def sac_her(env: gymnasium.Env, seed: int, threads: int) -> Any:
         seed=seed,
         device="cpu",
         verbose=0,
-        **sac_arguments(),
+        **sac_arguments(settings),
     )
 
 

@@ -31,8 +31,8 @@ from tqdm import tqdm
 from experiments import provenance, storage
 from experiments.baseline import control_learner as cl
 from experiments.baseline.control_settings import (
-    FIRST_HELD_OUT_SEED,
-    LEARNER,
+    CONTROL,
+    FIRST_TEST_SEED,
     NEAREST,
     RANDOM,
     RANDOM_COMMANDS_PER_GOAL,
@@ -51,7 +51,7 @@ RUNS = "runs"
 TABLE, RECORD, FIGURE = "rl-control.csv", "rl-control.json", "rl-control.png"
 COLUMNS = ["goal", "seed", "learner", "steps", "success", "critic_success", "saturated"]
 # What a run's settings share with the directory's (the rest, goal and seed, name the run).
-SHARED = ("movements", "eval_every", "eval_goals", "grasp")
+SHARED = ("movements", "eval_every", "eval_goals", "grasp", "settings", "test_goals")
 
 
 def goal_id(goal: str, grasp: str) -> str:
@@ -64,11 +64,6 @@ def goal_id(goal: str, grasp: str) -> str:
     return found
 
 
-def held_out_seeds(n: int) -> range:
-    """The reset seeds of the held-out goals (control_settings.py)."""
-    return range(FIRST_HELD_OUT_SEED, FIRST_HELD_OUT_SEED + n)
-
-
 def run_one(
     settings: ControlSettings, threads: int = TORCH_THREADS, bar: tqdm | None = None
 ) -> tuple[pd.DataFrame, dict]:
@@ -79,8 +74,8 @@ def run_one(
 
     env_id = goal_id(settings.goal, settings.grasp)
     env, test_env = gymnasium.make(env_id), gymnasium.make(env_id)
-    seeds = held_out_seeds(settings.eval_goals)
-    model = cl.sac_her(env, settings.seed, threads)
+    seeds = settings.test_seeds()
+    model = cl.sac_her(env, settings.seed, threads, settings.settings)
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []
     space = test_env.action_space
@@ -94,7 +89,8 @@ def run_one(
             if bar is not None:
                 bar.update(settings.eval_every)
         policy = cl.tested(cl.policy_act(model), test_env, seeds)
-        rows.append(_row(settings, LEARNER, steps, policy.success, cl.critic_view(model, policy)))
+        critic = cl.critic_view(model, policy)
+        rows.append(_row(settings, settings.learner, steps, policy.success, critic))
         if steps > 0:  # the nearest outcome needs movements to look among
             nearest = cl.tested(cl.nearest_outcome_act(model), test_env, seeds)
             rows.append(_row(settings, NEAREST, steps, nearest.success))
@@ -200,14 +196,15 @@ def _started(out: Path, first: ControlSettings) -> dict:
         return record
     if out.exists() and any(p.name != ".lock" for p in out.iterdir()):
         raise ControlError(f"{out} is not empty and holds no control: give another --out")
+    defaults = library_defaults()
     record = {
         "settings": {k: first.record()[k] for k in SHARED},
-        "held_out_goals": {
-            "first_reset_seed": FIRST_HELD_OUT_SEED,
+        "test_goals": {
+            "first_reset_seed": FIRST_TEST_SEED[first.test_goals],
             "random_commands_per_goal": RANDOM_COMMANDS_PER_GOAL,
         },
-        "learner": learner_values(),
-        "stable_baselines3_defaults": library_defaults(),
+        "learner": learner_values() if first.settings == CONTROL else defaults,
+        "stable_baselines3_defaults": defaults,
     }
     storage.write_json(path, record)
     return record

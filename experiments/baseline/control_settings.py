@@ -26,9 +26,15 @@ EVAL_GOALS = 200  # held-out goals per test
 # FIRST_HELD_OUT_SEED, +1, ... (never one met at rest: goal ids v1), the same for every run,
 # learner and test. Training episodes draw their rooms and goals from the run's own stream.
 FIRST_HELD_OUT_SEED = 1_000_000
-# Goals of the same kind for choosing the settings (docs/rl-baseline.md, "the settings"): never
+# Goals of the same kind for checking the settings (docs/rl-baseline.md, "The settings"), never
 # the held-out ones.
 FIRST_VALIDATION_SEED = 2_000_000
+HELD_OUT, VALIDATION = "held-out", "validation"
+FIRST_TEST_SEED = {HELD_OUT: FIRST_HELD_OUT_SEED, VALIDATION: FIRST_VALIDATION_SEED}
+# The learner's settings: the control's (HYPERPARAMETERS), or stable-baselines3's defaults alone
+# (the race's first learner, docs/rl-baseline.md).
+CONTROL, DEFAULTS = "control", "defaults"
+SETTINGS_CHOICES = (CONTROL, DEFAULTS)
 # Random arm commands tried per held-out goal, for the chance level.
 RANDOM_COMMANDS_PER_GOAL = 5
 # torch's CPU threads: the networks are small; one thread keeps a run's arithmetic in one order.
@@ -36,10 +42,9 @@ TORCH_THREADS = 1
 # The success on held-out goals a goal's learner should reach within MOVEMENTS (issue 50's
 # target for the hand), drawn on the figure.
 TARGETS = {"hand": 0.9}
-LEARNER = "sac-her"
+LEARNER = "sac-her"  # the learner's name in the curves' table; "sac-her-defaults" with DEFAULTS
 NEAREST = "nearest-outcome"
 RANDOM = "random-commands"
-LEARNERS = (LEARNER, NEAREST, RANDOM)
 
 # SAC's and HER's settings, each with why. The RL Zoo's tuned settings for FetchReach
 # (rl-baselines3-zoo, hyperparams/sac.yml: a sparse-reward reaching task with HER, the nearest
@@ -76,8 +81,10 @@ class ControlError(Exception):
 
 @dataclass(frozen=True)
 class ControlSettings:
-    """One control run: `movements` movements of SAC + HER on `goal`'s environment from `seed`,
-    tested on `eval_goals` held-out goals every `eval_every` movements (and before the first)."""
+    """One control run: `movements` movements of SAC + HER (`settings`: the control's, or
+    stable-baselines3's defaults) on `goal`'s environment from `seed`, tested on `eval_goals`
+    goals (`test_goals`: the held-out ones, or the validation ones) every `eval_every`
+    movements and before the first."""
 
     goal: str
     seed: int = 0
@@ -85,12 +92,20 @@ class ControlSettings:
     eval_every: int = EVAL_EVERY
     eval_goals: int = EVAL_GOALS
     grasp: str = DEFAULT_GRASP
+    settings: str = CONTROL
+    test_goals: str = HELD_OUT
 
     def __post_init__(self) -> None:
-        if self.goal not in CONTROL_GOALS:
-            raise ControlError(f"unknown goal {self.goal!r}: one of {', '.join(CONTROL_GOALS)}")
-        if self.grasp not in GRASPS:
-            raise ControlError(f"unknown grasp {self.grasp!r}: one of {', '.join(GRASPS)}")
+        for name, choices in (
+            ("goal", CONTROL_GOALS),
+            ("grasp", GRASPS),
+            ("settings", SETTINGS_CHOICES),
+            ("test_goals", tuple(FIRST_TEST_SEED)),
+        ):
+            if getattr(self, name) not in choices:
+                raise ControlError(
+                    f"unknown {name} {getattr(self, name)!r}: one of {', '.join(choices)}"
+                )
         for name, low in (("seed", 0), ("movements", 1), ("eval_every", 1), ("eval_goals", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
@@ -106,6 +121,16 @@ class ControlSettings:
         """The run's name among others: its files' stem."""
         return f"{self.goal}-seed{self.seed:04d}"
 
+    @property
+    def learner(self) -> str:
+        """The learner's name in the curves' table."""
+        return LEARNER if self.settings == CONTROL else f"{LEARNER}-{DEFAULTS}"
+
+    def test_seeds(self) -> range:
+        """The reset seeds of the goals it is tested on."""
+        first = FIRST_TEST_SEED[self.test_goals]
+        return range(first, first + self.eval_goals)
+
     def checkpoints(self) -> list[int]:
         """The movements after which the learner is tested: 0, eval_every, ..., movements."""
         return list(range(0, self.movements + 1, self.eval_every))
@@ -119,9 +144,11 @@ def learner_values() -> dict[str, Any]:
     return {name: value for name, (value, _) in HYPERPARAMETERS.items()}
 
 
-def sac_arguments() -> dict[str, Any]:
+def sac_arguments(settings: str = CONTROL) -> dict[str, Any]:
     """stable-baselines3's SAC keyword arguments of HYPERPARAMETERS (HerReplayBuffer's as
-    `replay_buffer_kwargs`, the networks as `policy_kwargs`)."""
+    `replay_buffer_kwargs`, the networks as `policy_kwargs`); none for DEFAULTS."""
+    if settings == DEFAULTS:
+        return {}
     values = learner_values()
     own = {k: v for k, v in values.items() if k not in HER_KEYS + POLICY_KEYS}
     return {

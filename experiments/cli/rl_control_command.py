@@ -10,14 +10,18 @@ import shlex
 import sys
 
 from experiments.baseline.control_settings import (
+    CONTROL,
     CONTROL_GOALS,
     EVAL_EVERY,
     EVAL_GOALS,
+    FIRST_TEST_SEED,
+    HELD_OUT,
     MOVEMENTS,
     SEEDS,
+    SETTINGS_CHOICES,
     TORCH_THREADS,
 )
-from experiments.cli.args import UsageError, positive_int
+from experiments.cli.args import UsageError, non_negative_int, positive_int
 from sim.grasping.names import DEFAULT_GRASP, GRASPS
 
 DESCRIPTION = (
@@ -27,7 +31,9 @@ DESCRIPTION = (
     "reward) for each goal and seed, and tested on held-out goals (drawn by the environment, "
     "never met at rest, the same for every run) before it moves and every --every movements, "
     "beside the nearest outcome among the movements it was given and random arm commands on "
-    "the same goals. Writes OUT/rl-control.csv (goal, seed, learner, steps, success, "
+    "the same goals. --settings defaults runs stable-baselines3's defaults instead; "
+    "--test-goals validation tests on goals kept for checking settings, never the held-out "
+    "ones. Writes OUT/rl-control.csv (goal, seed, learner, steps, success, "
     "critic_success, saturated), rl-control.json (settings, stable-baselines3's defaults, each "
     "run's seconds, libraries and machine) and rl-control.png; each run's curve is kept in "
     "OUT/runs/ when it ends, so that the same command run again skips the runs done. Needs the "
@@ -50,7 +56,28 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help=f"the goals (default: {' '.join(CONTROL_GOALS)})",
     )
     p.add_argument(
-        "--seeds", type=positive_int, default=SEEDS, help=f"seeds 0 to N-1 (default: {SEEDS})"
+        "--seeds", type=positive_int, default=SEEDS, help=f"how many seeds (default: {SEEDS})"
+    )
+    p.add_argument(
+        "--first-seed",
+        type=non_negative_int,
+        default=0,
+        metavar="S",
+        help="seeds S to S+N-1 (default: 0)",
+    )
+    p.add_argument(
+        "--settings",
+        choices=SETTINGS_CHOICES,
+        default=CONTROL,
+        help="the learner's: the control's (docs/rl-baseline.md) or stable-baselines3's "
+        f"defaults (default: {CONTROL})",
+    )
+    p.add_argument(
+        "--test-goals",
+        choices=tuple(FIRST_TEST_SEED),
+        default=HELD_OUT,
+        help="the goals tested on: the held-out ones, or the validation ones for checking "
+        f"settings (default: {HELD_OUT})",
     )
     p.add_argument(
         "--movements",
@@ -87,8 +114,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def cmd_rl_control(args: argparse.Namespace) -> None:
     from experiments.baseline.control_run import run_control
     from experiments.baseline.control_settings import (
-        LEARNER,
-        LEARNERS,
+        NEAREST,
+        RANDOM,
         TARGETS,
         ControlError,
         ControlSettings,
@@ -98,20 +125,30 @@ def cmd_rl_control(args: argparse.Namespace) -> None:
     try:
         runs = [
             ControlSettings(
-                goal, seed, args.movements, args.every, args.eval_goals, grasp=args.grasp
-            )
+                goal,
+                seed,
+                args.movements,
+                args.every,
+                args.eval_goals,
+                args.grasp,
+                args.settings,
+                args.test_goals,
+            )  # fmt: skip
             for goal in dict.fromkeys(args.goals)
-            for seed in range(args.seeds)
+            for seed in range(args.first_seed, args.first_seed + args.seeds)
         ]
+        actors = (runs[0].learner, NEAREST, RANDOM)
         command = ["playroom", "rl-control", "--out", args.out, "--goals", *args.goals]
-        command += ["--seeds", str(args.seeds), "--movements", str(args.movements)]
+        command += ["--seeds", str(args.seeds), "--first-seed", str(args.first_seed)]
+        command += ["--settings", args.settings, "--test-goals", args.test_goals]
+        command += ["--movements", str(args.movements)]
         command += ["--every", str(args.every), "--eval-goals", str(args.eval_goals)]
         command += ["--grasp", args.grasp, "--torch-threads", str(args.torch_threads)]
         table = run_control(
             args.out,
             runs,
             shlex.join(command),
-            lambda rows: control_png(rows, LEARNERS, TARGETS),
+            lambda rows: control_png(rows, actors, TARGETS),
             threads=args.torch_threads,
             progress=not args.quiet,
             notify=lambda line: print(f"playroom rl-control: {line}", file=sys.stderr, flush=True),
@@ -119,7 +156,7 @@ def cmd_rl_control(args: argparse.Namespace) -> None:
     except ControlError as exc:
         raise UsageError(str(exc)) from None
     print(f"{table}: the curves of {len(runs)} runs (and rl-control.json, rl-control.png)")
-    _print_final(table, LEARNER)
+    _print_final(table, actors[0])
 
 
 def _print_final(table_path: object, learner: str) -> None:

@@ -20,7 +20,14 @@ from experiments.cli.main import main
 def test_the_learner_is_tested_before_it_moves_and_every_eval_every_movements():
     settings = ControlSettings("stick", seed=2, movements=6000, eval_every=2000)
     assert settings.checkpoints() == [0, 2000, 4000, 6000]
-    assert settings.name == "stick-seed0002"
+    assert settings.name == "stick-seed0002" and settings.learner == "sac-her"
+
+
+def test_validation_goals_are_never_the_held_out_ones():
+    held_out = ControlSettings("hand", eval_goals=200).test_seeds()
+    validation = ControlSettings("hand", eval_goals=200, test_goals="validation").test_seeds()
+    assert len(held_out) == len(validation) == 200 and not set(held_out) & set(validation)
+    assert ControlSettings("hand", settings="defaults").learner == "sac-her-defaults"
 
 
 def test_each_hyperparameter_reaches_the_argument_stable_baselines3_reads():
@@ -34,6 +41,7 @@ def test_each_hyperparameter_reaches_the_argument_stable_baselines3_reads():
     flat = {k for k in arguments if not k.endswith("_kwargs")}
     assert flat | {"n_sampled_goal", "goal_selection_strategy", "net_arch"} == set(HYPERPARAMETERS)
     assert all(why for _, why in HYPERPARAMETERS.values())  # each one says why
+    assert sac_arguments("defaults") == {}  # stable-baselines3's own, every one
 
 
 @pytest.mark.parametrize(
@@ -41,6 +49,8 @@ def test_each_hyperparameter_reaches_the_argument_stable_baselines3_reads():
     [
         ({"goal": "toy1"}, "^unknown goal 'toy1': one of hand, stick$"),
         ({"goal": "hand", "grasp": "magnetic"}, "^unknown grasp 'magnetic'"),
+        ({"goal": "hand", "settings": "tuned"}, "^unknown settings 'tuned': one of control, de"),
+        ({"goal": "hand", "test_goals": "train"}, "^unknown test_goals 'train': one of held-out"),
         ({"goal": "hand", "seed": -1}, "^seed must be an integer >= 0, got -1$"),
         ({"goal": "hand", "movements": 1000, "eval_every": 300}, "multiple of eval_every"),
         ({"goal": "hand", "eval_goals": 0}, "^eval_goals must be an integer >= 1"),

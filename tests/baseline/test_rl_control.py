@@ -90,6 +90,8 @@ def test_the_command_writes_the_curves_skips_runs_done_and_refuses_other_setting
     assert set(table["learner"]) == {LEARNER, NEAREST, RANDOM}
     record = storage.read_json(out / "rl-control.json")
     assert record["learner"]["net_arch"] == [64, 64]
+    assert record["settings"]["settings"] == "control"
+    assert record["test_goals"]["first_reset_seed"] == 1_000_000
     assert record["stable_baselines3_defaults"]["net_arch"] == [256, 256]
     assert [r["settings"]["goal"] for r in record["runs"]] == ["hand", "stick"]
     assert (out / "rl-control.png").read_bytes()[:4] == b"\x89PNG"
