@@ -3,6 +3,7 @@ test` and `make run` never install it, and the package itself never needs it."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import tomllib
 from pathlib import Path
@@ -33,6 +34,21 @@ def test_only_make_test_slow_installs_it_and_requires_its_checks_to_run():
     # torch's CPU build: PyPI's default one brings gigabytes of CUDA libraries.
     assert f"--extra-index-url {_torch_index()} torch" in slow
     assert "PLAYROOM_RL_REQUIRED=1" in slow  # tests/sim/envs/test_env_sb3.py fails, not skips
+
+
+def test_make_install_rl_installs_the_extra_with_torchs_cpu_build():
+    install = _dry_run("install-rl")
+    assert f"--constraint constraints.txt --extra-index-url {_torch_index()} torch" in install
+    assert '--constraint constraints.txt -e ".[rl]"' in install
+    assert '".[rl]"' not in _dry_run("install")
+
+
+def test_the_docs_install_the_rl_extra_with_make_install_rl_only():
+    # pip's own line brings torch with CUDA (gigabytes); `make install-rl` the CPU build.
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    told = {page.name: page.read_text() for page in pages}
+    assert not [name for name, text in told.items() if re.search(r"pip install[^`\n]*\[rl\]", text)]
+    assert "make install-rl" in told["README.md"] and "make install-rl" in told["rl-baseline.md"]
 
 
 def _torch_index() -> str:

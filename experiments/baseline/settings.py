@@ -26,6 +26,12 @@ LEARNER = "sac-her"
 ALGORITHM = "SAC"
 REPLAY_BUFFER = "HerReplayBuffer"
 POLICY = "MultiInputPolicy"
+# The toy-goal environments as the race of docs/rl-baseline.md trained on them (their v0): both
+# motor spaces behind the switch `a[0]` (as the policy actor reads the test's commands,
+# experiments/measure/policy_actor.py) and episodes of 3 movements. v1 of the goal ids defaults to
+# the arm alone and one movement (sim/envs/goal_env.py); it also never draws a goal already met.
+MOTOR = "both"
+EPISODE_MOVEMENTS = 3
 # torch's CPU threads per run: the networks are small (256 x 256), so that runs side by side
 # on every core (`--config`) go faster than one run on many threads; 1 also keeps a run's
 # arithmetic in one order.

@@ -28,14 +28,21 @@ from sim.process_environment import environment_kept
 with environment_kept():
     import gymnasium
 
-from experiments.baseline.settings import ALGORITHM, POLICY, REPLAY_BUFFER, BaselineError
+from experiments.baseline.settings import (
+    ALGORITHM,
+    EPISODE_MOVEMENTS,
+    MOTOR,
+    POLICY,
+    REPLAY_BUFFER,
+    BaselineError,
+)
 from models.layout import block_slice
 from sim.caregiver import WordAssignment
 from sim.config import WorldConfig
 from sim.envs.versions import GOAL_VARIANTS
 from sim.vocal.config import VoiceConfig
 
-RL_EXTRA = 'pip install -e ".[rl]"'
+RL_EXTRA = "make install-rl"
 _SOUND = block_slice("sound")
 # The SAC settings that baseline's training.json records (their values are the library's).
 RECORDED = (
@@ -62,7 +69,7 @@ def rl_library() -> Any:
     except ImportError as exc:
         raise BaselineError(
             f"the RL baseline needs the `rl` extra (stable-baselines3, torch): {RL_EXTRA} "
-            f"(`make test-slow` installs it into .venv); {exc}"
+            f"(stable-baselines3 and torch's CPU build into .venv); {exc}"
         ) from None
     return stable_baselines3
 
@@ -114,7 +121,13 @@ def make_env(
     import sim.envs  # noqa: F401  (registers the ids)
 
     env = gymnasium.make(
-        goal_id(grasp), goal=f"toy{toy}", grasp=grasp, config=world, voice_config=voice
+        goal_id(grasp),
+        goal=f"toy{toy}",
+        motor=MOTOR,
+        movements=EPISODE_MOVEMENTS,
+        grasp=grasp,
+        config=world,
+        voice_config=voice,
     )
     return SameWords(env, words)
 

@@ -30,7 +30,7 @@ DESCRIPTION = (
     "seeds, iterations and placements), side by side. A stopped run resumes when the same "
     "command is run again; a finished one is refused (with --config: skipped), and so is a "
     "directory of other settings. Needs "
-    'the `rl` extra: pip install -e ".[rl]". docs/rl-baseline.md has the protocol.'
+    "the `rl` extra: make install-rl. docs/rl-baseline.md has the protocol."
 )
 
 

@@ -9,7 +9,7 @@ iterations (one step = one arm or voice command, as the study's agent acts):
   `gymnasium.make("sim.envs:Playroom-v1", grasp="physical")` works without importing it first;
 - `PlayroomGoalEnv` (sim/envs/goal_env.py): the same world with one of the study's goals, in
   Gymnasium-Robotics' goal-conditioned form (for hindsight relabelling), registered as
-  "PlayroomHandGoal-v0" and its siblings (sim/envs/versions.py, `GOAL_VARIANTS`).
+  "PlayroomHandGoal-v1" and its siblings (sim/envs/versions.py, `GOAL_VARIANTS`).
 
 Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
 (sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
@@ -32,7 +32,7 @@ from sim.envs.versions import (
     DIVA_ID,
     ENTRY_POINT,
     GOAL_ENTRY_POINT,
-    GOAL_EPISODE_STEPS,
+    GOAL_REGISTRATION,
     GOAL_VARIANTS,
     GYM_ID,
     PHYSICAL_ID,
@@ -54,13 +54,9 @@ for _id, _kwargs in VARIANTS.items():
         )
 for _id, _kwargs in GOAL_VARIANTS.items():
     if _id not in registry:
-        # A goal episode is a few movements (GOAL_EPISODE_STEPS' comment), ended by TimeLimit.
-        register(
-            id=_id,
-            entry_point=GOAL_ENTRY_POINT,
-            max_episode_steps=GOAL_EPISODE_STEPS,
-            kwargs=_kwargs,
-        )
+        # A goal episode is ended by the environment itself after its movements, and
+        # `gymnasium.make` returns the environment unwrapped (GOAL_REGISTRATION's comment).
+        register(id=_id, entry_point=GOAL_ENTRY_POINT, kwargs=_kwargs, **GOAL_REGISTRATION)
 
 __all__ = [
     "DIVA_ID",

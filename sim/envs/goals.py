@@ -30,6 +30,13 @@ from sim.vocal.config import VoiceConfig
 
 SOUND = "sound"
 WORD = "word"
+# The rings `info["ring"]` names (`ring_of`): a point the hand reaches, or one only a held
+# stick's end reaches.
+NEAR, FAR = "near", "far"
+# Draws of a desired goal before `draw_unmet` gives up: a goal space where this many draws are
+# all met at rest is a world the environment cannot set a task in (in the study's worlds fewer
+# than 5% of draws are met: the stick's handle, 4.3%).
+MAX_DRAWS = 1000
 
 
 @dataclass(frozen=True)
@@ -132,6 +139,36 @@ def draw_desired(
     radius = rng.uniform(low, high)
     angle = rng.uniform(0.0, 2.0 * np.pi)
     return radius * np.array([np.cos(angle), np.sin(angle)]), None
+
+
+def draw_unmet(
+    goal: Goal, room: Playroom, rng: np.random.Generator, tolerance: float
+) -> tuple[np.ndarray, str | None]:
+    """A desired goal (float32) not already met where things lie (`achieved_at_rest`), and for
+    a word its name: `draw_desired` again until the goal lies at `tolerance` or more from what is
+    achieved at rest (distances of the float32 goals, as the rewards are computed). So its
+    distribution is the study's placement rule with the goals already met cut out. RuntimeError
+    after MAX_DRAWS draws all met."""
+    at_rest = achieved_at_rest(goal, room).astype(np.float32)
+    for _ in range(MAX_DRAWS):
+        desired, word = draw_desired(goal, room, rng)
+        desired = desired.astype(np.float32)
+        if distance(at_rest, desired) >= tolerance:
+            return desired, word
+    raise RuntimeError(
+        f"{MAX_DRAWS} desired {goal.name} goals drawn were all met at rest: this world leaves "
+        "no goal to reach"
+    )
+
+
+def ring_of(goal: Goal, desired: np.ndarray, config: WorldConfig) -> str | None:
+    """Where a position goal lies: NEAR within the arm's reach (`arm_length`, 0.5 m from its
+    base: the study's ring 1, the hand's), FAR beyond it (ring 2: only a held stick's end
+    reaches it); None for a sound."""
+    if not goal.is_position:
+        return None
+    reach = config.arm_length
+    return NEAR if float(np.linalg.norm(np.asarray(desired, dtype=np.float64))) <= reach else FAR
 
 
 def distance(achieved: np.ndarray, desired: np.ndarray) -> np.ndarray:

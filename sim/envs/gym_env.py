@@ -31,6 +31,7 @@ from sim.envs.world import SEED_BOUND, checked_seed, event_dicts
 from sim.grasping.names import DEFAULT_GRASP
 from sim.movement import posed_as
 from sim.mujoco_import import mujoco
+from sim.physics import CONTROL_SUBSTEPS
 from sim.task import ARM, VOICE
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig
 
@@ -42,7 +43,10 @@ ACTION_DIM = VOICE_PART.stop  # 50
 # What the spaces hold: what learning libraries expect (stable-baselines3 warns of float64).
 # The room computes in float64; actions are read into float64, observations rounded at the end.
 SPACE_DTYPE = np.float32
-RENDER_MODES = ("human", "rgb_array")
+RENDER_MODES = ("human", "rgb_array", "rgb_array_list")
+# "rgb_array_list" (Gymnasium's name): every frame since the last render, one after a reset and
+# one after each control step of a movement.
+FRAME_LIST = "rgb_array_list"
 
 
 class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
@@ -140,25 +144,29 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
     | `voice`       | None ("vtl") | the vocal tract: "vtl" or "diva" (DIVA's data: below)   |
     | `voice_config`| VoiceConfig()| the voice's numbers (vowels, words, recognition)        |
     | `iterations`  | 80000        | commands per episode, made directly (not with `make`)   |
-    | `render_mode` | None         | "rgb_array" or "human" (where a display exists)         |
+    | `render_mode` | None         | "rgb_array", "rgb_array_list" or "human" (a display)    |
     | `render_size` | (640, 480)   | (width, height) of an "rgb_array" frame                 |
     | `camera`      | "top"        | the MJCF's camera: "top" or "hand_view"                 |
 
     DIVA's formant map is the user's: `playroom voice-data diva PATH` installs it once; without
     it "diva" raises DivaDataMissing, which names the file and the command.
 
-    Rendering (sim/envs/rendering.py): a frame after `step` shows the room at the movement's
-    last control step, before the arm returns to rest and the room places things for the next
-    command (so RecordVideo, one frame a step, shows the arm move); after `reset`, the room as
-    it is. To see a movement's end the room steps it one control step at a time (the path
-    videos take, the same world bit for bit but slower), which an episode does from its first
-    `render()` on: render after `reset` (RecordVideo does), and an environment never rendered
-    (stable-baselines3 makes them with "rgb_array") steps at full speed. Frames come offscreen
-    from the GL backend MUJOCO_GL names (EGL when unset); with no render mode nothing loads a GL
-    library. "human" shows the room in MuJoCo's viewer after every reset and step; it is
-    declared only where a display exists (DISPLAY or WAYLAND_DISPLAY), so that Gymnasium's
-    `check_env`, which makes the environment in every declared mode, passes on a machine
-    without one.
+    Rendering (sim/envs/rendering.py): under "rgb_array" a frame after `step` shows the room at
+    the movement's last control step, before the arm returns to rest and the room places things
+    for the next command (RecordVideo, one frame a step at `render_fps` 1, a movement a second,
+    shows where each movement ended); after `reset`, the room as it is. "rgb_array_list"
+    (Gymnasium's name) gives the movement itself: `render()` returns every frame since the last
+    one, a frame after each reset and one after each of a movement's 50 control steps, at
+    `render_fps` 50 (real time), which Gymnasium's `save_video` writes as a video. To see a
+    movement the room steps it one control step at a time (the path videos take, the same world
+    bit for bit but slower), which an episode does from its first `render()` on ("rgb_array":
+    render after `reset`, as RecordVideo does) or from its reset ("rgb_array_list"); an
+    environment never rendered (stable-baselines3 makes them with "rgb_array") steps at full
+    speed. Frames come offscreen from the GL backend MUJOCO_GL names (EGL when unset); with no
+    render mode nothing loads a GL library. "human" shows the room in MuJoCo's viewer after
+    every reset and step; it is declared only where a display exists (DISPLAY or
+    WAYLAND_DISPLAY), so that Gymnasium's `check_env`, which makes the environment in every
+    declared mode, passes on a machine without one.
 
     ## Version History
 
@@ -167,14 +175,16 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
       does ("vtl", "diva"), its numbers are `voice_config`; the variants PlayroomPhysical-v1
       (grasp="physical") and PlayroomDiva-v1 (voice="diva"); a frame after a step shows the
       movement's end; "human" declared only where a display exists; an "rgb_array" renderer
-      not closed is closed at exit.
+      not closed is closed at exit; later, with no change to what v1 did: "rgb_array_list",
+      a movement's frames at `render_fps` 50.
     * v0: initial version: float64 spaces, no `max_episode_steps` (the environment truncated
       itself after `iterations`), `voice` a VoiceConfig, frames after a step showing the arm
       back at rest.
     """
 
-    # One step is one movement of 50 control steps of 20 ms: a second of the room. What `make`
-    # reads; an instance declares the modes that can work where it runs (`__init__`).
+    # One step is one movement of 50 control steps of 20 ms: a second of the room, one frame
+    # (RecordVideo's). What `make` reads; an instance declares the modes that can work where it
+    # runs, and "rgb_array_list"'s rate, a frame a control step (`__init__`).
     metadata: dict[str, Any] = {"render_modes": list(RENDER_MODES), "render_fps": 1}
 
     def __init__(
@@ -198,11 +208,15 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         # Gymnasium's MuJoCo environments declare "human" everywhere and fail at the first
         # render; check_env makes and renders every declared mode, so there it would fail.
         modes = [m for m in RENDER_MODES if m != "human" or display_missing() is None]
-        self.metadata = {**type(self).metadata, "render_modes": modes}
-        self.render_mode = render_mode
         self.movement_env = PlayroomMovementEnv(
             grasp, preset, config, voice, voice_config, iterations
         )
+        fps = type(self).metadata["render_fps"]
+        if render_mode == FRAME_LIST:  # 50: one frame a 20 ms control step
+            timestep = self.movement_env.room.physics.model.opt.timestep
+            fps = round(1.0 / (timestep * CONTROL_SUBSTEPS))
+        self.metadata = {**type(self).metadata, "render_modes": modes, "render_fps": fps}
+        self.render_mode = render_mode
         self.render_size = checked_view(
             self.movement_env.room.physics.model.ptr, render_size, camera
         )
@@ -213,6 +227,7 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         self._render_data: Any = None
         # The episode's movements are watched from its first render on (see the docstring).
         self._watcher: MovementEnd | None = None
+        self._frames: list[Any] = []  # "rgb_array_list"'s frames since the last render
         self._stepped_unwatched = False
         self._warned_unwatched = False
         b = self.movement_env.bounds
@@ -236,6 +251,8 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         info = {"seed": room_seed, "iteration": 0, "events": [], "event_counts": _counts(timestep)}
         if self.render_mode == "human":
             self.render()
+        if self.render_mode == FRAME_LIST:
+            self._frames = [self._frame(None)]  # and from here on each movement's
         return _flat(timestep.observation), info
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -267,31 +284,27 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         }
         if self.render_mode == "human":
             self.render()
+        if self.render_mode == FRAME_LIST:
+            assert self._watcher is not None  # set by reset
+            path = self._watcher.path  # None: the movement diverged, the room put back
+            self._frames += [self._frame(None)] if path is None else map(self._frame, path)
         return _flat(timestep.observation), 0.0, False, timestep.last(), info
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> np.ndarray | list[Any] | None:
         """A frame under "rgb_array", the viewer shown under "human" (None): the room at the
-        last movement's last control step, or as it is after a reset; with no render mode, a
-        warning and None, as Gymnasium's own environments do."""
+        last movement's last control step, or as it is after a reset; under "rgb_array_list",
+        every frame since the last render (after a reset, the room; after a step, one a control
+        step of its movement); with no render mode, a warning and None, as Gymnasium's own
+        environments do."""
         if self.render_mode is None:
             logger.warn(
                 "render() without a render mode renders nothing: make the environment with "
                 'render_mode="rgb_array" or "human"'
             )
             return None
-        room = self.movement_env.room
-        model = room.physics.model.ptr
-        if room is not self._rendered_room:  # a new episode's room: a new model and data
-            self.close()
-            # The frames come from a copy of the room's state, made consistent by mj_forward
-            # there: the room's own MjData is never computed on, so rendering changes no bit of
-            # the world.
-            self._render_data = mujoco.MjData(model)
-            if self.render_mode == "rgb_array":
-                self._renderer = OffscreenRenderer(model, self.render_size, self.camera)
-            else:
-                self._renderer = Viewer(model, self._render_data)
-            self._rendered_room = room
+        if self.render_mode == FRAME_LIST:
+            frames, self._frames = self._frames, []
+            return frames
         if self._watcher is None:
             if self._stepped_unwatched and not self._warned_unwatched:
                 self._warned_unwatched = True
@@ -300,16 +313,47 @@ class PlayroomGymEnv(gymnasium.Env[np.ndarray, np.ndarray]):
                     "an episode's movements are shown from its first render() on; render after "
                     "reset() to see them all (RecordVideo does)"
                 )
-            self._watcher = MovementEnd(room)
-        pose = self._watcher.pose
-        data = room.physics.data.ptr
-        now = (data.qpos, data.mocap_pos, data.mocap_quat)
-        posed_as(model, self._render_data, *(now if pose is None else pose))
-        if isinstance(self._renderer, OffscreenRenderer):
-            return self._renderer.render(self._render_data)
-        assert self._renderer is not None
+        pose = self._ready().pose
+        if self.render_mode == "rgb_array":
+            return self._frame(pose)
+        self._pose(pose)
+        assert isinstance(self._renderer, Viewer)
         self._renderer.show()
         return None
+
+    def _ready(self) -> MovementEnd:
+        """The renderer of the episode's room (a new room: a new model and data), and its
+        watcher of movements."""
+        room = self.movement_env.room
+        if room is not self._rendered_room:
+            self.close()
+            # The frames come from a copy of the room's state, made consistent by mj_forward
+            # there: the room's own MjData is never computed on, so rendering changes no bit of
+            # the world.
+            model = room.physics.model.ptr
+            self._render_data = mujoco.MjData(model)
+            if self.render_mode == "human":
+                self._renderer = Viewer(model, self._render_data)
+            else:
+                self._renderer = OffscreenRenderer(model, self.render_size, self.camera)
+            self._rendered_room = room
+        if self._watcher is None:
+            self._watcher = MovementEnd(room)
+        return self._watcher
+
+    def _pose(self, pose: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> None:
+        """The render data posed as `pose` (qpos, mocap_pos, mocap_quat), or as the room is."""
+        room = self.movement_env.room
+        data = room.physics.data.ptr
+        now = (data.qpos, data.mocap_pos, data.mocap_quat)
+        posed_as(room.physics.model.ptr, self._render_data, *(now if pose is None else pose))
+
+    def _frame(self, pose: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> np.ndarray:
+        """An RGB frame of the room posed as `pose`, or as it is."""
+        self._ready()
+        self._pose(pose)
+        assert isinstance(self._renderer, OffscreenRenderer)
+        return self._renderer.render(self._render_data)
 
     def close(self) -> None:
         """Frees the renderer or closes the viewer (a renderer not closed is freed at exit)."""

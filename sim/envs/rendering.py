@@ -180,10 +180,18 @@ class MovementEnd:
     @property
     def pose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """(qpos, mocap_pos, mocap_quat) at the last movement's end, or None."""
+        path = self.path
+        return None if path is None else path[-1]
+
+    @property
+    def path(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]] | None:
+        """(qpos, mocap_pos, mocap_quat) after each control step of the last movement, first to
+        last (the trace's rows 1 to N_STEPS; row 0 is the room before it), or None."""
         trace = self.room.last_trace
         if trace is None or trace is self._forgotten:
             return None
-        return trace.qpos[-1], trace.mocap_pos[-1], self.room.physics.data.ptr.mocap_quat
+        quat = self.room.physics.data.ptr.mocap_quat
+        return [(trace.qpos[k], trace.mocap_pos[k], quat) for k in range(1, len(trace.qpos))]
 
 
 def display_missing() -> str | None:

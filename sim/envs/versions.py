@@ -31,12 +31,13 @@ VARIANTS: dict[str, dict[str, Any]] = {
 ENTRY_POINT = "sim.envs.gym_env:make_registered"
 
 # The goal-conditioned ids (sim/envs/goal_env.py): the world of the ids above with one of the
-# study's goals. Their own versions: a new VERSION of the world makes a new one of these too.
-GOAL_VERSION = 0
-# Movements per goal episode: one reaches any goal drawn but a toy in the study's ring 3, which
-# needs the caregiver's help first (a name or two) and then the arm (PlayroomGoalEnv's docstring,
-# "Episode End"); short enough that the room never re-places the toys (every 20 iterations).
-GOAL_EPISODE_STEPS = 3
+# study's goals. Their own versions (PlayroomGoalEnv's docstring holds the history): a new
+# VERSION of the world makes a new one of these too.
+GOAL_VERSION = 1
+# Movements per goal episode by default: one, as the study gives each goal one movement
+# (docs/protocol.md §9), the episode then terminated. The environment counts them itself (no
+# `max_episode_steps`: see GOAL_REGISTRATION).
+GOAL_MOVEMENTS = 1
 # id -> its goal and grasp backend: each goal with the kinematic grasp, and "Physical" with the
 # physical one. The toy ids bring toy1 (`goal="toy2"` or "toy3" for another).
 GOAL_VARIANTS: dict[str, dict[str, Any]] = {
@@ -45,3 +46,11 @@ GOAL_VARIANTS: dict[str, dict[str, Any]] = {
     for suffix, grasp in (("", {}), ("Physical", {"grasp": "physical"}))
 }
 GOAL_ENTRY_POINT = "sim.envs.goal_env:make_goal_registered"
+# How the goal ids are registered: without Gymnasium's wrappers (TimeLimit, OrderEnforcing,
+# PassiveEnvChecker), so that `gymnasium.make(goal_id)` is the environment itself. Gymnasium
+# 1.x's wrappers forward no attribute, and stable-baselines3 finds a goal environment on
+# `env.unwrapped` but calls `compute_reward` on the wrapper it was given ('TimeLimit' object has
+# no attribute 'compute_reward'). The environment ends its own episodes and refuses a step
+# before `reset` or after the end, what TimeLimit and OrderEnforcing did; the tests run
+# Gymnasium's checker in place of the passive one.
+GOAL_REGISTRATION: dict[str, Any] = {"order_enforce": False, "disable_env_checker": True}

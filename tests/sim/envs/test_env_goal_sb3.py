@@ -1,7 +1,8 @@
 """The goal-conditioned environments in a real reinforcement-learning library: stable-baselines3's
-SAC with its HerReplayBuffer, every default kept, builds from each id (both grasp backends),
-relabels with the environment's `compute_reward` and learns a few hundred steps without error.
-Not a performance claim: nothing here says it learns to reach goals.
+`check_env` takes what `gymnasium.make` gives for each id, whole; SAC with its HerReplayBuffer,
+every default kept, builds from each id (both grasp backends), relabels with the environment's
+`compute_reward` and learns a few hundred steps without error. Not a performance claim: nothing
+here says it learns to reach goals (the positive control does: tests/baseline/).
 
 `make test-slow` installs the `rl` extra (pyproject.toml) and runs these; elsewhere they are
 skipped where stable-baselines3 is not installed, with the reason."""
@@ -21,13 +22,21 @@ from sim.envs import GOAL_VARIANTS
 
 require_stable_baselines3()
 
+import gymnasium  # noqa: E402
 from stable_baselines3 import SAC, HerReplayBuffer  # noqa: E402
+from stable_baselines3.common.env_checker import check_env  # noqa: E402
 
 pytestmark = pytest.mark.slow
 
 DOCS = Path(__file__).resolve().parents[3] / "docs" / "environments.md"
 # SAC's default learning_starts is 100: 300 steps are 200 gradient steps on relabelled batches.
 STEPS = 300
+
+
+@pytest.mark.parametrize("env_id", list(GOAL_VARIANTS))
+def test_stable_baselines_check_env_takes_what_make_gives_whole(env_id):
+    # v0's TimeLimit failed here: "'TimeLimit' object has no attribute 'compute_reward'".
+    check_env(gymnasium.make(f"sim.envs:{env_id}"))
 
 
 @pytest.mark.parametrize("env_id", list(GOAL_VARIANTS))

@@ -1,6 +1,7 @@
-"""Frames of the Gymnasium environment as Gymnasium's video wrappers take them, one after each
-reset and step: each shows the movement the step made (the arm where the movement ended), and a
-renderer left open at exit goes without GL errors."""
+"""Frames of the Gymnasium environment as Gymnasium's video tools take them: RecordVideo's, one
+after each reset and step, each showing where the step's movement ended; "rgb_array_list"'s,
+every control step of the movement at its own rate, which Gymnasium's `save_video` writes as the
+movement; and a renderer left open at exit goes without GL errors."""
 
 from __future__ import annotations
 
@@ -105,6 +106,49 @@ def test_recordvideos_own_writer_files_a_clip_of_the_arm_moving(tmp_path):
     frames = [np.frombuffer(f, np.uint8).reshape(height, width, 3) for f in reader]
     assert (width, height) == SIZE and len(frames) == 2
     assert _arm_near(frames[1], uv) and not _arm_near(frames[0], uv)
+
+
+def test_a_movements_frames_come_as_a_list_one_a_control_step_at_its_rate():
+    env = gymnasium.make(GYM_ID, render_mode="rgb_array_list", render_size=SIZE)
+    assert env.metadata["render_fps"] == 50  # a control step lasts 20 ms: real time
+    assert gymnasium.make(GYM_ID, render_mode="rgb_array").metadata["render_fps"] == 1
+    env.reset(seed=0)
+    room = env.unwrapped.movement_env.room
+    env.step(_arm_action(room.config))
+    frames = env.render()
+    assert env.render() == []  # each frame is given once
+    assert len(frames) == 1 + 50  # after the reset, then after each control step
+    assert all(f.shape == (SIZE[1], SIZE[0], 3) and f.dtype == np.uint8 for f in frames)
+    # The hand where the feedback saw it mid-movement (step 25) and at its end (step 50).
+    hand = env.unwrapped.movement_env.last_feedback.positions[:, 0]  # row k - 1: after step k
+    model, data = room.physics.model.ptr, room.physics.data.ptr
+    height = data.geom_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "hand"), 2]
+    view = CameraView.of(model, data, "top", *SIZE)
+    mid, end = (view.project(np.r_[hand[k - 1], height])[0] for k in (25, 50))
+    assert np.linalg.norm(hand[-1] - HAND_END) < 0.02
+    assert _arm_near(frames[25], mid) and not _arm_near(frames[0], mid)
+    assert _arm_near(frames[50], end) and not _arm_near(frames[25], end)
+    env.close()
+
+
+@pytest.mark.slow  # MoviePy (the `rl` extra) encodes the clip through ffmpeg
+def test_gymnasiums_save_video_writes_the_movement_in_real_time(tmp_path):
+    require("moviepy")
+    from gymnasium.utils.save_video import save_video
+
+    env = gymnasium.make(GYM_ID, render_mode="rgb_array_list", render_size=SIZE)
+    env.reset(seed=0)
+    env.step(_arm_action(env.unwrapped.movement_env.room.config))
+    save_video(env.render(), str(tmp_path), fps=env.metadata["render_fps"], name_prefix="arm")
+    env.close()
+    (clip,) = tmp_path.glob("arm*.mp4")
+    reader = imageio_ffmpeg.read_frames(str(clip))
+    meta = next(reader)
+    assert meta["size"] == SIZE and meta["fps"] == 50
+    frames = [np.frombuffer(f, np.uint8).reshape(SIZE[1], SIZE[0], 3).astype(int) for f in reader]
+    # The reset's frame and the movement's 50, a second of the room; MoviePy 1.0.3 ends a clip
+    # with its last frame once more.
+    assert len(frames) == 52 and np.abs(frames[-1] - frames[-2]).mean() < 0.1
 
 
 def test_a_frame_after_a_step_made_before_any_render_says_what_it_shows():

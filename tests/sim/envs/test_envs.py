@@ -67,8 +67,8 @@ def headless(monkeypatch):
 def _checked_quietly(env: gymnasium.Env) -> None:
     # Gymnasium's checker, unmodified: it warns about what it only recommends, and here every
     # warning fails. Its render check makes and renders the environment in each declared mode
-    # ("rgb_array" offscreen here; "human" where a display exists: tests/sim/envs/
-    # test_env_rendering.py runs it under Xvfb).
+    # ("rgb_array" and "rgb_array_list" offscreen here; "human" where a display exists:
+    # tests/sim/envs/test_env_rendering.py runs it under Xvfb).
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env)
@@ -79,12 +79,13 @@ def test_gym_env_passes_gymnasiums_whole_checker_through_make_without_a_display(
     _checked_quietly(env.unwrapped)
     assert env.unwrapped.spec.id == GYM_ID
     # "human" is declared only where it can open a window; asked for, it says why not.
-    assert env.unwrapped.metadata["render_modes"] == ["rgb_array"]
+    assert env.unwrapped.metadata["render_modes"] == ["rgb_array", "rgb_array_list"]
 
 
 def test_the_viewer_is_declared_where_a_display_exists(monkeypatch):
     monkeypatch.setenv("DISPLAY", ":99")  # (no window opens without a render mode)
-    assert PlayroomGymEnv(iterations=2).metadata["render_modes"] == ["human", "rgb_array"]
+    modes = PlayroomGymEnv(iterations=2).metadata["render_modes"]
+    assert modes == ["human", "rgb_array", "rgb_array_list"]
 
 
 def test_gym_env_is_found_by_module_path_and_builds_a_physical_room_that_passes_the_checker(
@@ -317,7 +318,8 @@ def test_bad_settings_are_refused_in_one_line(kwargs, message):
 
 def test_gym_env_refuses_unknown_render_modes_reset_options_and_bad_seeds():
     with pytest.raises(
-        ValueError, match="unknown render_mode 'ansi': one of \\['human', 'rgb_array'\\]"
+        ValueError,
+        match="unknown render_mode 'ansi': one of \\['human', 'rgb_array', 'rgb_array_list'\\]",
     ):
         PlayroomGymEnv(render_mode="ansi")
     with pytest.raises(ValueError, match="unknown camera 'side'"):

@@ -17,10 +17,11 @@ from scripted import Waypoint, arm_command_through
 from models.layout import block_slice
 from sim.envs import GOAL_VARIANTS, PlayroomGoalEnv
 from sim.envs import goals as g
-from sim.envs.versions import GOAL_EPISODE_STEPS
+from sim.envs.versions import GOAL_MOVEMENTS, GOAL_VERSION
 
 IDS = list(GOAL_VARIANTS)
-ARM, VOICE = -1.0, 1.0  # a[0]: the motor space
+ARM, VOICE = -1.0, 1.0  # a[0]: the motor space of motor="both"
+MOVEMENTS = 3  # episodes of a few movements, where a test needs them
 # Toys parked in ring 3, away from the scripted reach for the stick.
 PARKED_TOYS = np.array([[-0.75, -0.55], [-0.15, -0.9], [-0.8, 0.5]])
 
@@ -41,27 +42,30 @@ def headless(monkeypatch):
 @pytest.mark.parametrize("env_id", IDS)
 def test_gymnasiums_whole_checker_passes_on_every_goal_id(env_id, headless):
     env = gymnasium.make(f"sim.envs:{env_id}")
+    assert type(env) is PlayroomGoalEnv  # no wrapper: the environment itself
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the checker's advice fails too
-        check_env(env.unwrapped)
-    room = env.unwrapped.playroom.movement_env.room
+        check_env(env)
+    room = env.playroom.movement_env.room
     assert room.grasp == GOAL_VARIANTS[env_id].get("grasp", "kinematic")
-    assert env.spec.max_episode_steps == GOAL_EPISODE_STEPS
+    assert env.spec.max_episode_steps is None  # the environment ends its own episodes
     assert env.observation_space["achieved_goal"].dtype == np.float32
 
 
 # Rewards as hindsight relabelling computes them ---------------------------------------------
 @pytest.mark.parametrize("env_id", IDS)
-def test_compute_reward_on_a_batch_equals_the_rewards_of_the_steps(env_id):
-    env = gymnasium.make(env_id)
+@pytest.mark.parametrize("kind", ["sparse", "dense"])
+def test_compute_reward_on_a_batch_equals_the_rewards_of_the_steps(env_id, kind):
+    env = gymnasium.make(env_id, motor="both", movements=MOVEMENTS, reward=kind)
     rng = np.random.default_rng(1)
     achieved, desired, rewards, infos = [], [], [], []
     for seed in range(3):
         obs, _ = env.reset(seed=seed)
-        for k in range(GOAL_EPISODE_STEPS):
+        for k in range(MOVEMENTS):
             obs, reward, terminated, truncated, info = env.step(_action((ARM, VOICE)[k % 2], rng))
-            assert not terminated and truncated == (k == GOAL_EPISODE_STEPS - 1)
-            assert info["is_success"] == float(reward == 0.0)
+            assert terminated == (k == MOVEMENTS - 1) and not truncated
+            distance = g.distance(obs["achieved_goal"], obs["desired_goal"])
+            assert info["is_success"] == float(distance < env.unwrapped.tolerance)
             achieved.append(obs["achieved_goal"])
             desired.append(obs["desired_goal"])
             rewards.append(reward)
@@ -71,9 +75,12 @@ def test_compute_reward_on_a_batch_equals_the_rewards_of_the_steps(env_id):
     assert batch.shape == (len(rewards),)
     np.testing.assert_array_equal(batch, rewards)
     # Relabelled as HER does (desired := an achieved goal of the episode): successes appear.
-    relabelled = env.unwrapped.compute_reward(a, a[::-1].copy(), infos)
     assert (env.unwrapped.compute_reward(a, a, infos) == 0.0).all()
-    assert set(np.unique(relabelled)) <= {-1.0, 0.0}
+    if kind == "sparse":
+        relabelled = env.unwrapped.compute_reward(a, a[::-1].copy(), infos)
+        assert set(np.unique(relabelled)) <= {-1.0, 0.0}
+    else:  # minus the distance
+        np.testing.assert_allclose(batch, -np.linalg.norm(a - d, axis=1), rtol=1e-6)
     assert not env.unwrapped.compute_terminated(a, d, infos).any()
 
 
@@ -91,10 +98,10 @@ def test_the_tolerance_is_the_studys_distance_and_strict(goal, tol):
 
 # A goal reached -----------------------------------------------------------------------------
 @pytest.mark.parametrize("grasp", ["kinematic", "physical"])
-@pytest.mark.parametrize(("goal", "space"), [("hand", ARM), ("toy3", ARM), ("word", VOICE)])
-def test_a_desired_goal_set_to_what_a_command_achieves_is_a_success(grasp, goal, space):
-    env = PlayroomGoalEnv(goal, grasp=grasp)
-    action = _action(space, np.random.default_rng(3))
+@pytest.mark.parametrize("goal", ["hand", "toy3", "word"])
+def test_a_desired_goal_set_to_what_a_command_achieves_is_a_success(grasp, goal):
+    env = PlayroomGoalEnv(goal, grasp=grasp)  # each goal's own motor space
+    action = np.random.default_rng(3).uniform(-1, 1, env.action_space.shape).astype(np.float32)
     env.reset(seed=5)
     achieved = env.step(action)[0]["achieved_goal"]
     # The same room, the same command: the same outcome, now the goal.
@@ -120,11 +127,11 @@ def _stick_sweep(env: PlayroomGoalEnv) -> tuple[np.ndarray, np.ndarray]:
     ]
     m, error = arm_command_through(waypoints, room.config)
     assert error < 0.02
-    return np.r_[ARM, m, np.zeros(28)].astype(np.float32), end
+    return m.astype(np.float32), end
 
 
 def test_the_stick_carried_to_the_desired_point_reaches_the_goal():
-    env = gymnasium.make("sim.envs:PlayroomStickGoal-v0")
+    env = gymnasium.make(f"sim.envs:PlayroomStickGoal-v{GOAL_VERSION}", movements=MOVEMENTS)
     obs, _ = env.reset(seed=0, options={"desired_goal": [0.05, 0.3]})
     np.testing.assert_allclose(obs["achieved_goal"], [-0.25, 0.0])  # the stick's start
     action, end = _stick_sweep(env.unwrapped)
@@ -133,15 +140,15 @@ def test_the_stick_carried_to_the_desired_point_reaches_the_goal():
     assert (reward, info["is_success"]) == (0.0, 1.0)
     handle = obs["observation"][10:][block_slice("stick")].reshape(2, 5)[:, -1]
     np.testing.assert_array_equal(obs["achieved_goal"], handle)  # the study's stick model
-    # A still arm leaves the stick where it was dropped: still reached, never terminated, and
-    # the episode ends after its movements.
-    still = np.r_[ARM, np.zeros(49)].astype(np.float32)
+    # A still arm leaves the stick where it was dropped: still reached, and the episode ends
+    # (terminated) after its movements.
+    still = np.zeros(21, dtype=np.float32)
     assert env.step(still)[1:4] == (0.0, False, False)
-    assert env.step(still)[1:4] == (0.0, False, True)
+    assert env.step(still)[1:4] == (0.0, True, False)
 
 
 def test_the_word_goal_is_the_agents_own_sound_never_the_caregivers_word():
-    env = PlayroomGoalEnv("word")
+    env = PlayroomGoalEnv("word", motor="both", movements=2)
     obs, info = env.reset(seed=2)
     room = env.playroom.movement_env.room
     assert info["desired_word"] in room.vocal_tract.config.words
@@ -181,7 +188,8 @@ def test_the_docstring_tells_the_ids_goals_and_episode_length():
         assert f"## {section}" in doc
     assert all(env_id in doc for env_id in IDS)
     assert all(f'"{name}"' in doc for name in g.GOALS)
-    assert re.search(rf"Truncated after {GOAL_EPISODE_STEPS} movements", doc)
+    assert re.search(r"Terminated after `movements` movements \(1 by default", doc)
+    assert GOAL_MOVEMENTS == 1 and "* v1:" in doc and "* v0:" in doc
 
 
 # Refused input ------------------------------------------------------------------------------
@@ -189,7 +197,13 @@ def test_the_docstring_tells_the_ids_goals_and_episode_length():
     ("make", "message"),
     [
         (lambda: PlayroomGoalEnv("tail"), "^unknown goal 'tail': one of hand, stick, toy1"),
-        (lambda: gymnasium.make(IDS[0], iterations=5), "give max_episode_steps=5, not iterations$"),
+        (lambda: gymnasium.make(IDS[0], iterations=5), "give movements=5, not iterations$"),
+        (lambda: PlayroomGoalEnv(motor="legs"), "^unknown motor 'legs': one of arm, voice, both"),
+        (lambda: PlayroomGoalEnv(movements=0), "^movements must be a positive integer, got 0$"),
+        (lambda: PlayroomGoalEnv(movements=1.5), "^movements must be a positive integer"),
+        (lambda: PlayroomGoalEnv(reward="shaped"), "^unknown reward 'shaped': one of sparse, den"),
+        (lambda: PlayroomGoalEnv().step(np.zeros(21)), "^call reset\\(\\) first$"),
+        (lambda: _reset(PlayroomGoalEnv()).step(np.zeros(50)), "must have shape \\(21,\\), got"),
         (lambda: PlayroomGoalEnv().reset(options={"goal": 1}), "only the option 'desired_goal'"),
         (lambda: PlayroomGoalEnv().reset(options={"desired_goal": [1.0]}), "shape \\(2,\\)"),
         (lambda: PlayroomGoalEnv().reset(options={"desired_goal": [np.nan, 0]}), "within \\+-1.3"),
@@ -197,6 +211,11 @@ def test_the_docstring_tells_the_ids_goals_and_episode_length():
     ],
 )
 def test_bad_input_is_refused_in_one_line(make, message):
-    with pytest.raises(ValueError, match=message) as caught:
+    with pytest.raises((ValueError, RuntimeError), match=message) as caught:
         make()
     assert "\n" not in str(caught.value)
+
+
+def _reset(env: PlayroomGoalEnv) -> PlayroomGoalEnv:
+    env.reset(seed=0)
+    return env
