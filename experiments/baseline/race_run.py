@@ -22,7 +22,7 @@ import io
 import multiprocessing
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
@@ -69,10 +69,9 @@ def _env(run: RaceRun, motor: str | None = None) -> Any:
 
     import sim.envs  # noqa: F401  (registers the ids)
 
-    extra = {} if motor is None else {"motor": motor}
     trial = run.trial
     return gymnasium.make(
-        rl.toys_goal_id(trial.grasp), preset=trial.preset, voice=trial.voice, **extra
+        rl.toys_goal_id(trial.grasp), preset=trial.preset, voice=trial.voice, motor=motor
     )
 
 
@@ -150,15 +149,14 @@ def run_race(
     out_dir: str | os.PathLike,
     runs: Sequence[RaceRun],
     command: str,
+    figure: Callable[[pd.DataFrame], bytes],
     workers: int = 1,
     threads: int = TORCH_THREADS,
 ) -> Path:
     """Every run not yet done, side by side on `workers` processes, then the tables, record and
-    figure of all (the module's docstring); the table's path. RaceError (one line) before any
-    work for a directory of other settings or one another process writes; naming every run that
-    failed, after the others are done."""
-    from experiments.report.rl_race_figure import race_png
-
+    figure of all (the module's docstring; `figure` draws it from the table); the table's path.
+    RaceError (one line) before any work for a directory of other settings or one another
+    process writes; naming every run that failed, after the others are done."""
     out = Path(out_dir)
     if not runs:
         raise RaceError("no run asked for: give at least one learner, grasp and seed")
@@ -201,7 +199,7 @@ def run_race(
             {
                 TABLE: text.getvalue().encode(),
                 CLAIMS: claims(table).to_csv(index=False, float_format="%.4g").encode(),
-                FIGURE: race_png(table),
+                FIGURE: figure(table),
                 RECORD: storage.json_bytes(storage.finite_or_null(record)),
             },
         )

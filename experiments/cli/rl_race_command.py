@@ -77,11 +77,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def cmd_rl_race(args: argparse.Namespace) -> None:
     from experiments.baseline.race_run import CLAIMS, run_race
     from experiments.baseline.race_settings import RaceError, race_runs
+    from experiments.report.rl_race_figure import race_png
 
     try:
+        learners = list(dict.fromkeys(args.learners))
         runs = race_runs(
             args.config,
-            list(dict.fromkeys(args.learners)),
+            learners,
             args.seeds,
             args.iterations,
             args.grasps,
@@ -98,6 +100,7 @@ def cmd_rl_race(args: argparse.Namespace) -> None:
             args.out,
             runs,
             shlex.join(command),
+            lambda rows: race_png(rows, learners),
             workers=args.workers or os.cpu_count() or 1,
             threads=args.torch_threads,
         )

@@ -5,18 +5,22 @@ and each seed as a thin one."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pandas as pd
 from matplotlib.figure import Figure
 
-from experiments.baseline.race_settings import LEARNERS
 from experiments.report.figures import png_bytes
 
-COLOURS = dict(zip(LEARNERS, ("tab:green", "tab:orange", "tab:blue"), strict=True))
+# Each learner's colour, in the order given (Model Babbling's first).
+COLOURS = ("tab:green", "tab:orange", "tab:blue", "tab:grey")
 RINGS = ("near", "far", "all")
 
 
-def race_figure(table: pd.DataFrame) -> Figure:
-    """The curves of `table` (columns learner, grasp, seed, steps, ring, success)."""
+def race_figure(table: pd.DataFrame, learners: Sequence[str]) -> Figure:
+    """The curves of `table` (columns learner, grasp, seed, steps, ring, success), a colour for
+    each of `learners`."""
+    colours = {learner: COLOURS[i % len(COLOURS)] for i, learner in enumerate(learners)}
     grasps = list(dict.fromkeys(table["grasp"]))
     fig = Figure(figsize=(4.2 * len(RINGS), 3.2 * len(grasps)), layout="constrained")
     axes = fig.subplots(len(grasps), len(RINGS), squeeze=False, sharey=True)
@@ -24,7 +28,7 @@ def race_figure(table: pd.DataFrame) -> Figure:
         for ax, ring in zip(row, RINGS, strict=True):
             rows = table[(table["grasp"] == grasp) & (table["ring"] == ring)]
             for learner, mine in rows.groupby("learner", sort=False):
-                colour = COLOURS.get(str(learner), "tab:grey")
+                colour = colours.get(str(learner), COLOURS[-1])
                 for _, seed in mine.groupby("seed"):
                     ax.plot(seed["steps"], 100 * seed["success"], color=colour, lw=0.6, alpha=0.4)
                 mean = mine.groupby("steps")["success"].mean()
@@ -39,5 +43,5 @@ def race_figure(table: pd.DataFrame) -> Figure:
     return fig
 
 
-def race_png(table: pd.DataFrame) -> bytes:
-    return png_bytes(race_figure(table))
+def race_png(table: pd.DataFrame, learners: Sequence[str]) -> bytes:
+    return png_bytes(race_figure(table, learners))
