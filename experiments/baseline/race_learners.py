@@ -37,11 +37,14 @@ def toys_goal_id(grasp: str) -> str:
     return found
 
 
-def tested_goals(act: Act, env: gymnasium.Env, seeds: Sequence[int]) -> pd.DataFrame:
-    """`act`'s one movement toward the goal of `env.reset(seed=s)` for each seed: a row per goal
-    (TESTED: its reset seed, toy, ring, the motor space played, whether it was reached)."""
+def tested_goals(
+    act: Act, env: gymnasium.Env, seeds: Sequence[int], tries: int = 1
+) -> pd.DataFrame:
+    """`act`'s one movement toward the goal of `env.reset(seed=s)` for each seed (`tries`
+    movements from the same start, each scored, for a noisy actor): a row per movement
+    (TESTED: the goal's reset seed, toy, ring, the motor space played, whether it reached it)."""
     rows = []
-    for seed in seeds:
+    for seed in (s for s in seeds for _ in range(tries)):
         observation, info = env.reset(seed=seed)
         _, _, _, _, after = env.step(act(observation))
         rows.append(

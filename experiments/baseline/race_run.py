@@ -8,7 +8,8 @@ the paired comparisons (race_claims.py), the record and the figure.
 - Model Babbling: the trial itself (experiments/run/trial.py) in trials/GRASP-seedNNNN/, run
   to each budget in turn (a trial extended equals one run to the larger number from the start),
   its agent read back at each (`load_trial`) and tested, each test kept in
-  trials/GRASP-seedNNNN-tests/ so that a stopped run resumes at its first budget not tested.
+  trials/GRASP-seedNNNN-tests/ so that a stopped run resumes at its first budget not tested;
+- random arm commands: the chance level on the same goals (control_learner.py `random_act`).
 
 The directory: race.json (what every run shares; a directory of other settings is refused);
 runs/NAME.csv and .json when a run ends (its curve; seconds, libraries, machine): a run done is
@@ -32,9 +33,20 @@ import pandas as pd
 from experiments import provenance, storage
 from experiments.baseline import control_learner as cl
 from experiments.baseline import race_learners as rl
-from experiments.baseline.control_settings import TORCH_THREADS, learner_values, library_defaults
+from experiments.baseline.control_settings import (
+    RANDOM_COMMANDS_PER_GOAL,
+    TORCH_THREADS,
+    learner_values,
+    library_defaults,
+)
 from experiments.baseline.race_claims import claims
-from experiments.baseline.race_settings import MODEL_BABBLING, SAC_SETTINGS, RaceError, RaceRun
+from experiments.baseline.race_settings import (
+    MODEL_BABBLING,
+    RANDOM_COMMANDS,
+    SAC_SETTINGS,
+    RaceError,
+    RaceRun,
+)
 from experiments.baseline.training import library_versions, rl_library
 from experiments.file_names import CONFIG_FILE
 from experiments.run.lock import DirectoryLock, DirectoryLocked
@@ -47,7 +59,8 @@ ALL_RINGS = "all"
 
 
 def curve_rows(run: RaceRun, steps: int, tested: pd.DataFrame) -> list[dict[str, Any]]:
-    """A test's rows: the share of held-out goals reached, near, far and in all."""
+    """A test's rows: the share of held-out goals reached, near, far and in all (`goals`: the
+    movements tested, several a goal for random commands)."""
     rows = []
     for ring, goals in (*tested.groupby("ring"), (ALL_RINGS, tested)):
         rows.append(
@@ -91,6 +104,19 @@ def run_sac(run: RaceRun, threads: int = TORCH_THREADS) -> tuple[list[dict[str, 
     return rows, testing
 
 
+def run_random(run: RaceRun) -> tuple[list[dict[str, Any]], float]:
+    """The chance level: random arm commands on the held-out goals, RANDOM_COMMANDS_PER_GOAL a
+    goal from a generator of the run's seed, tested once (nothing learns) and written at every
+    budget; and the seconds the test took."""
+    env = _env(run)
+    start = time.perf_counter()
+    act = cl.random_act(env.action_space, run.trial.seed)
+    tested = rl.tested_goals(act, env, run.test_seeds(), RANDOM_COMMANDS_PER_GOAL)
+    testing = time.perf_counter() - start
+    env.close()
+    return [row for budget in run.budgets() for row in curve_rows(run, budget, tested)], testing
+
+
 def run_model_babbling(run: RaceRun, trial_dir: Path) -> tuple[list[dict[str, Any]], float]:
     """Model Babbling's curve (the module's docstring), and the seconds its tests took."""
     from experiments.run.trial import run_trial
@@ -123,6 +149,8 @@ def run_one(out: Path, run: RaceRun, threads: int = TORCH_THREADS) -> str:
     if run.learner == MODEL_BABBLING:
         trial_dir = out / TRIALS / f"{run.trial.grasp}-seed{run.trial.seed:04d}"
         rows, testing = run_model_babbling(run, trial_dir)
+    elif run.learner == RANDOM_COMMANDS:
+        rows, testing = run_random(run)
     else:
         rows, testing = run_sac(run, threads)
     record = {

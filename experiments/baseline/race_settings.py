@@ -1,5 +1,6 @@
 """The race's settings, every number in one place: Model Babbling against two deep RL learners
-(SAC + HER with stable-baselines3's defaults, and with the positive control's settings), one
+(SAC + HER with stable-baselines3's defaults, and with the positive control's settings) and
+random arm commands (the chance level), one
 goal-conditioned policy for the three toys (PlayroomToysGoal-v1: the toy part of the goal, the
 arm alone, one movement a goal), each given the same movements, all tested on the same held-out
 toy goals at the same budgets. Model Babbling's trials are the batch config's
@@ -23,7 +24,10 @@ RACE_CONFIG = Path("experiments") / "batches" / "rl-baseline" / "comparison.json
 MODEL_BABBLING = "model-babbling"
 SAC_DEFAULTS = "sac-her-defaults"  # SAC + HER, stable-baselines3's defaults
 SAC_CONTROL = "sac-her"  # SAC + HER, the positive control's settings (control_settings.py)
-LEARNERS = (MODEL_BABBLING, SAC_DEFAULTS, SAC_CONTROL)
+# The chance level on the same goals: uniform random arm commands (no learning: the same share
+# at every budget), RANDOM_COMMANDS_PER_GOAL of them a goal.
+RANDOM_COMMANDS = "random-commands"
+LEARNERS = (MODEL_BABBLING, SAC_DEFAULTS, SAC_CONTROL, RANDOM_COMMANDS)
 # Each deep RL learner's settings in control_settings.py's names.
 SAC_SETTINGS = {SAC_DEFAULTS: DEFAULTS, SAC_CONTROL: CONTROL}
 EVAL_EVERY = 2_000  # movements between two tests of every learner

@@ -14,8 +14,15 @@ from rl_extra import require_stable_baselines3
 
 import sim.envs  # noqa: F401  (registers the ids)
 from experiments.baseline import race_learners as rl
+from experiments.baseline.control_settings import RANDOM_COMMANDS_PER_GOAL
 from experiments.baseline.race_run import COLUMNS, run_model_babbling
-from experiments.baseline.race_settings import LEARNERS, MODEL_BABBLING, RACE_CONFIG, race_runs
+from experiments.baseline.race_settings import (
+    LEARNERS,
+    MODEL_BABBLING,
+    RACE_CONFIG,
+    RANDOM_COMMANDS,
+    race_runs,
+)
 from experiments.cli.main import main
 from experiments.measure.evaluation import GOAL_TIMES
 
@@ -46,11 +53,17 @@ def test_the_tiny_race_tests_every_learner_on_the_same_goals_and_resumes(tmp_pat
     table = pd.read_csv(out / "rl-race.csv")
     assert list(table.columns) == COLUMNS
     assert set(table["learner"]) == set(LEARNERS) and set(table["steps"]) == {100, 200}
-    everyone = table[table["ring"] == "all"]
-    assert (everyone["goals"] == 10).all()
-    # The same goals for every learner: as many near and far for each.
-    by_ring = table[table["ring"] != "all"].groupby(["learner", "ring"])["goals"].first().unstack()
+    everyone = table[table["ring"] == "all"].set_index("learner")["goals"]
+    assert (everyone.drop(RANDOM_COMMANDS) == 10).all()
+    assert (everyone[RANDOM_COMMANDS] == 10 * RANDOM_COMMANDS_PER_GOAL).all()
+    # The same goals for every learner: as many near and far for each (random commands try
+    # each goal RANDOM_COMMANDS_PER_GOAL times).
+    rings = table[table["ring"] != "all"].copy()
+    rings.loc[rings["learner"] == RANDOM_COMMANDS, "goals"] //= RANDOM_COMMANDS_PER_GOAL
+    by_ring = rings.groupby(["learner", "ring"])["goals"].first().unstack()
     assert (by_ring.nunique() == 1).all() and by_ring.sum(axis=1).eq(10).all()
+    chance = table[table["learner"] == RANDOM_COMMANDS].groupby("ring")["success"].nunique()
+    assert (chance == 1).all()  # nothing learns: the same share at every budget
     claims = pd.read_csv(out / "rl-race-claims.csv")
     assert set(claims["learner"]) == set(LEARNERS) - {MODEL_BABBLING}
     assert (claims["claim"] == "no difference shown").all()  # one seed claims nothing

@@ -114,3 +114,18 @@ def test_bad_given_goals_are_refused_in_one_line(options, message):
     assert "\n" not in str(caught.value)
     with pytest.raises(ValueError, match="draws its toy"):
         PlayroomToysGoalEnv(goal="toy1")
+
+
+@pytest.mark.slow
+def test_hindsight_relabelling_rewards_the_episodes_own_toy_at_its_own_outcome():
+    require("stable_baselines3")
+    from stable_baselines3 import SAC, HerReplayBuffer
+
+    model = SAC("MultiInputPolicy", IDS[0], replay_buffer_class=HerReplayBuffer, seed=0)
+    model.learn(300)  # SAC's default learning_starts is 100: 200 gradient steps, relabelled
+    batch = model.replay_buffer.sample(256)
+    # HER's "future" goal of a one-movement episode is its own outcome, of the same toy: a
+    # success (0) among the failures (-1) of the drawn goals.
+    assert set(np.unique(batch.rewards.numpy())) == {-1.0, 0.0}
+    toys = batch.observations["desired_goal"][:, :3].numpy()
+    np.testing.assert_array_equal(toys.sum(axis=1), 1.0)
