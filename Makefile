@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install install-rl lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline rl-control clean
+.PHONY: install install-rl lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline rl-control rl-race clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -195,6 +195,18 @@ rl-control: $(RL_INSTALLED)
 	mkdir -p docs/data
 	cp $(RL_CONTROL)/rl-control.csv $(RL_CONTROL)/rl-control.json docs/data/
 	cp $(RL_CONTROL)/rl-control.png docs/rl-control.png
+
+## rl-race: Model Babbling against SAC + HER (stable-baselines3's defaults, and the control's
+## settings), one policy of the three toys, on the trials of experiments/batches/rl-baseline/
+## comparison.json (both backends, 8 seeds x 20000 movements), all tested on the same 300
+## held-out toy goals every 2000 (`playroom rl-race`, on every core; docs/rl-race.md: its
+## cost), then its tables, record and figure copied into docs/; rerunning resumes
+RL_RACE := $(OUT)/rl-race
+rl-race: $(RL_INSTALLED)
+	$(BIN)/playroom rl-race --out $(RL_RACE) --config $(RL_BASELINE)
+	mkdir -p docs/data
+	cp $(RL_RACE)/rl-race.csv $(RL_RACE)/rl-race-claims.csv $(RL_RACE)/rl-race.json docs/data/
+	cp $(RL_RACE)/rl-race.png docs/rl-race.png
 
 ## test-slow: the longer checks marked `slow` (with the `rl` extra installed: those checks fail
 ## rather than skip without it), then the whole suite with another CPU emulated

@@ -9,7 +9,9 @@ iterations (one step = one arm or voice command, as the study's agent acts):
   `gymnasium.make("sim.envs:Playroom-v1", grasp="physical")` works without importing it first;
 - `PlayroomGoalEnv` (sim/envs/goal_env.py): the same world with one of the study's goals, in
   Gymnasium-Robotics' goal-conditioned form (for hindsight relabelling), registered as
-  "PlayroomHandGoal-v1" and its siblings (sim/envs/versions.py, `GOAL_VARIANTS`).
+  "PlayroomHandGoal-v1" and its siblings (sim/envs/versions.py, `GOAL_VARIANTS`); and
+  `PlayroomToysGoalEnv` (sim/envs/toys_goal_env.py), the three toys in one goal environment,
+  the toy part of the goal ("PlayroomToysGoal-v1", `TOYS_GOAL_VARIANTS`).
 
 Both check actions with one check (sim/envs/actions.py); the Gymnasium one renders
 (sim/envs/rendering.py; a GL library is loaded only for a render mode). Both build each
@@ -37,6 +39,8 @@ from sim.envs.versions import (
     GYM_ID,
     PHYSICAL_ID,
     STUDY_ITERATIONS,
+    TOYS_GOAL_ENTRY_POINT,
+    TOYS_GOAL_VARIANTS,
     VARIANTS,
 )
 
@@ -57,12 +61,16 @@ for _id, _kwargs in GOAL_VARIANTS.items():
         # A goal episode is ended by the environment itself after its movements, and
         # `gymnasium.make` returns the environment unwrapped (GOAL_REGISTRATION's comment).
         register(id=_id, entry_point=GOAL_ENTRY_POINT, kwargs=_kwargs, **GOAL_REGISTRATION)
+for _id, _kwargs in TOYS_GOAL_VARIANTS.items():
+    if _id not in registry:
+        register(id=_id, entry_point=TOYS_GOAL_ENTRY_POINT, kwargs=_kwargs, **GOAL_REGISTRATION)
 
 __all__ = [
     "DIVA_ID",
     "GOAL_VARIANTS",
     "GYM_ID",
     "PHYSICAL_ID",
+    "TOYS_GOAL_VARIANTS",
     "PlayroomGoalEnv",
     "PlayroomGymEnv",
     "PlayroomMovementEnv",

@@ -212,7 +212,7 @@ class PlayroomGoalEnv(gymnasium.Env[DictObs, np.ndarray]):
         super().reset(seed=seed)
         room = self.playroom.movement_env.room
         if given is None:
-            desired, word = goals.draw_unmet(self.goal, room, self.np_random, self.tolerance)
+            desired, word = self._drawn_goal(room)
             if word is not None:
                 info["desired_word"] = word
         else:
@@ -274,6 +274,10 @@ class PlayroomGoalEnv(gymnasium.Env[DictObs, np.ndarray]):
 
     def close(self) -> None:
         self.playroom.close()
+
+    def _drawn_goal(self, room: Any) -> tuple[np.ndarray, str | None]:
+        """A desired goal drawn from `np_random`, never met at rest (and a word's name)."""
+        return goals.draw_unmet(self.goal, room, self.np_random, self.tolerance)
 
     def _given_goal(self, options: dict[str, Any] | None) -> np.ndarray | None:
         """The desired goal `options` gives, checked against the goal space (a one-line

@@ -46,6 +46,15 @@ GOAL_VARIANTS: dict[str, dict[str, Any]] = {
     for suffix, grasp in (("", {}), ("Physical", {"grasp": "physical"}))
 }
 GOAL_ENTRY_POINT = "sim.envs.goal_env:make_goal_registered"
+# One goal environment for the three toys, the toy drawn each episode and part of the goal
+# (sim/envs/toys_goal_env.py, its docstring holds the history): one policy for the three toys,
+# as the race with Model Babbling wants (docs/rl-race.md). Registered as the goal ids are.
+TOYS_GOAL_VERSION = 1
+TOYS_GOAL_VARIANTS: dict[str, dict[str, Any]] = {
+    f"PlayroomToysGoal{suffix}-v{TOYS_GOAL_VERSION}": grasp
+    for suffix, grasp in (("", {}), ("Physical", {"grasp": "physical"}))
+}
+TOYS_GOAL_ENTRY_POINT = "sim.envs.toys_goal_env:make_toys_goal_registered"
 # How the goal ids are registered: without Gymnasium's wrappers (TimeLimit, OrderEnforcing,
 # PassiveEnvChecker), so that `gymnasium.make(goal_id)` is the environment itself. Gymnasium
 # 1.x's wrappers forward no attribute, and stable-baselines3 finds a goal environment on
