@@ -17,9 +17,7 @@ from experiments import provenance, storage
 from experiments.analysis import step_split
 from experiments.analysis.results import BatchResults, check_out_dir
 from experiments.analysis.trial_tests import ALPHA, survives
-from experiments.eval_worlds import READ_BY
-from experiments.report import ladder
-from experiments.report.ablations import describe_change
+from experiments.report import ladder, rung_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
 from experiments.report.pages import machines_text, p_value, seeds_text
@@ -75,36 +73,33 @@ def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[d
     return [dict(r) for r in table[mask].to_dict("records")]
 
 
-def _change(before: dict, config: dict) -> str:
-    """What a rung changes from the one before, each world setting that its backend does not
-    read said so: another backend's switch (experiments/eval_worlds.py READ_BY)."""
-    grasp = config["trial"]["grasp"]
-    others = {name for g, names in READ_BY.items() if g != grasp for name in names}
-    unread = others - set(READ_BY.get(grasp, ()))
-    parts = []
-    for part in describe_change(before, config).split("; "):
-        key = part.split(":", 1)[0]
-        name = key.removeprefix("world.")
-        inert = key.startswith("world.") and name in unread
-        parts.append(f"{part} (not read by the {grasp} backend)" if inert else part)
-    return "; ".join(parts)
-
-
-def rungs_table(rungs: list[ladder.Rung], own: dict[str, BatchResults]) -> list[str]:
-    lines = ["| rung | batch | changes from the rung before | trials (seeds) | computed on |"]
-    lines.append("|---|---|---|---|---|")
+def rungs_table(
+    rungs: list[ladder.Rung], beside: list[ladder.Rung], own: dict[str, BatchResults]
+) -> list[str]:
+    """One row per rung: its batch, everything it changes from the rung before (a rung beside
+    the ladder: from the last rung) (rung_change.describe), its trials and where they were
+    computed."""
+    head = "| rung | batch | changes from the rung before | trials (seeds) | computed on |"
+    lines = [head, "|---|---|---|---|---|"]
     before = None
-    for rung in rungs:
+    last = None
+    for rung in [*rungs, *beside]:
+        if rung in beside:
+            before = last
         results = own[rung.name]
         group = results.groups[0]
-        config = results.configs[group]
-        change = "(the first rung)" if before is None else _change(before, config)
+        world = rung_change.RungWorld(
+            results.configs[group], rung_change.recorded_backend(results.trials)
+        )
+        change = "(the first rung)" if before is None else rung_change.describe(before, world)
         seeds = sorted(int(s) for s in results.trials["seed"])
         lines.append(
             f"| {rung.name} | {rung.batch_dir.name} ({group}) | {change} | "
             f"{len(seeds)} ({seeds_text(seeds)}) | {machines_text(results)} |"
         )
-        before = config
+        before = world
+        if rung == rungs[-1]:
+            last = world
     return lines
 
 
@@ -255,9 +250,13 @@ def markdown(
         "survives Holm's correction over the page's one family (below), for its kind of p. No "
         "test here pools tests or words across agents. Shares in percentage points.",
         "",
-        *rungs_table([*rungs, *beside], read.own),
+        *rungs_table(rungs, beside, read.own),
         "",
-        "## Each rung's step",
+        "## Each rung's step, given the rules before it",
+        "",
+        "A step measures what the rule its rung changes does given the rules before it, in "
+        "this one order: another order, or a rule that acts with another, can give the same "
+        "rule another share of the whole.",
         "",
         *steps_table(read.measures, steps, levels, order, others),
         "",

@@ -220,14 +220,34 @@ def test_the_rungs_means_are_over_the_seeds_the_steps_pair(batches, tmp_path):
     assert mean["a"] + step["mean"] == pytest.approx(mean["b"])
 
 
-def _read(values: pd.DataFrame, grasps: dict[str, str]) -> ladder.LadderRead:
-    """A ladder read from hand-made values: each rung's own results a hand-made batch whose
-    config names its backend and world settings (`grasps`: rung -> backend)."""
+# What each backend records of itself (backend.json) in the study preset's world.
+BACKENDS = {
+    "kinematic": {"reach": 0.6, "solid": False, "pushes": False, "closed_form": True},
+    "physical": {"reach": 0.546, "solid": True, "pushes": True, "closed_form": False},
+}
+
+
+def _config(grasp: str, **world) -> dict:
+    """config.json's settings of a study-preset trial (the seed left out, as a group's)."""
+    from sim.config import world_preset
+
+    return {
+        "trial": {"grasp": grasp, "preset": "study"},
+        "world": dataclasses.asdict(world_preset("study", **world)),
+    }
+
+
+def _read(values: pd.DataFrame, configs: dict[str, dict]) -> ladder.LadderRead:
+    """A ladder read from hand-made values: each rung's own results a hand-made batch with the
+    rung's config (`configs`: rung -> _config) and its backend's record."""
     own = {}
-    for rung, grasp in grasps.items():
+    for rung, config in configs.items():
         results = batch(rung, list(SEEDS))
-        config = {"trial": {"grasp": grasp}, "world": {"catch_rule": "study"}}
-        own[rung] = dataclasses.replace(results, configs={rung: config})
+        record = BACKENDS[config["trial"]["grasp"]]
+        if config["trial"]["grasp"] == "physical" and not config["world"]["push_objects"]:
+            record = {**record, "pushes": False}
+        trials = results.trials.drop(columns=["pushes", "closed_form"]).assign(**record)
+        own[rung] = dataclasses.replace(results, trials=trials, configs={rung: config})
     return ladder.LadderRead(values, _headline(), own, [])
 
 
@@ -237,7 +257,7 @@ def test_the_page_gives_a_rank_p_beside_every_t_and_names_the_cells_whose_star_d
     from experiments.report.ladder_page import ladder_files
 
     rungs = [ladder.Rung(r, Path(r)) for r in ("A", "B", "C")]
-    read = _read(_values(LEVELS), {"A": "kinematic", "B": "kinematic", "C": "kinematic"})
+    read = _read(_values(LEVELS), {r: _config("kinematic") for r in ("A", "B", "C")})
     files = ladder_files(read, rungs, [], "playroom ladder A=A B=B C=C --out x")
     page = files["ladder.md"].decode()
     tests = pd.read_csv(io.BytesIO(files["ladder.csv"]))
@@ -252,3 +272,47 @@ def test_the_page_gives_a_rank_p_beside_every_t_and_names_the_cells_whose_star_d
     assert "A -> B (step)" in section
     assert f"One family of {len(tests)} tests" in page and "steps' sum" not in page
     assert "## Completeness" in page and "Complete: every rung holds every seed" in page
+
+
+def test_a_rung_of_another_backend_lists_everything_it_changes_and_who_reads_it():
+    """servo-arm -> contact-aligned: a setting the earlier rung never read is said so (it did
+    not push or weld anything), a rule only one rung applies is listed although its value did
+    not change, and what each rung's world does as its trials recorded it."""
+    from experiments.report.ladder_page import ladder_files
+
+    configs = {
+        "servo-arm": _config("kinematic", catch_rule="held_stick", arm_dynamics="servo"),
+        "contact-aligned": _config("physical", push_objects=False, held_pose="aligned"),
+    }
+    values = _values({"servo-arm": LEVELS["A"], "contact-aligned": LEVELS["B"]})
+    rungs = [ladder.Rung(r, Path(r)) for r in configs]
+    page = ladder_files(_read(values, configs), rungs, [], "cmd")["ladder.md"].decode()
+    row = next(line for line in page.splitlines() if line.startswith("| contact-aligned |"))
+    for said in (
+        "trial.grasp: kinematic -> physical",
+        "world.push_objects: True -> False (not read by the earlier rung's kinematic backend)",
+        "world.held_pose: touch -> aligned (not read by the earlier rung's kinematic backend)",
+        "world.arm_dynamics: servo -> set (not read by the later rung's physical backend)",
+        "world.catch_distance: 0.1, read by the earlier rung's kinematic backend only",
+        "world.stick_return_reach: 0.53, read by the later rung's physical backend only",
+        "backend: the hand takes the stick's handle within (m) 0.600 -> 0.546",
+        "backend: solid objects (placements clear of the stick and of each other; unheld "
+        "objects block the hand and what it holds): no -> yes",
+        "backend: movements computed in closed form (no dynamics): yes -> no",
+    ):
+        assert said in row, said
+    assert "objects pushed" not in row  # neither rung pushes
+
+
+def test_one_order_is_worded_as_each_rule_given_the_rules_before_it():
+    from experiments.report.ladder_figure import waterfall
+    from experiments.report.ladder_page import ladder_files
+
+    read = _read(_values(LEVELS), {r: _config("kinematic") for r in ("A", "B", "C")})
+    rungs = [ladder.Rung(r, Path(r)) for r in ("A", "B", "C")]
+    page = ladder_files(read, rungs, [], "cmd")["ladder.md"].decode()
+    assert "## Each rung's step, given the rules before it" in page
+    steps = ladder.step_tests(read.values, ["A", "B", "C"], [], _headline())
+    levels = ladder.levels(read.values)
+    figure = waterfall(_headline(), steps, levels, ["A", "B", "C"])
+    assert "given the rules before it" in figure.get_suptitle()
