@@ -30,7 +30,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         "(`playroom eval DIR --world W`) each step with both rungs' agents tested in one "
         "world and their own worlds against it; Holm's correction over the page's one family "
         "of tests; a check that every rung holds every seed and world. Writes ladder.md, "
-        "ladder.csv, ladder.json and ladder.png into --out.",
+        "ladder.csv (every test), ladder-trials.csv (every trial's values in every world, "
+        "with the machine and commit that computed it), ladder.json and ladder.png into --out.",
     )
     p.add_argument(
         "rungs",
@@ -70,4 +71,4 @@ def cmd_ladder(args: argparse.Namespace) -> None:
     except ReportError as exc:
         raise UsageError(str(exc)) from None
     print(page.read_text(), end="")
-    print(f"written: {page}, ladder.csv, ladder.json, ladder.png")
+    print(f"written: {page}, ladder.csv, ladder-trials.csv, ladder.json, ladder.png")

@@ -20,8 +20,8 @@ test world W, into both rungs' agents tested in W and the rungs' own worlds agai
 
 The family of tests is declared here (`FAMILY`, `family`) from the rungs and the measures
 alone, before any value is read; Holm's correction runs over it, for each kind of p. The page
-itself: experiments/report/ladder_page.py; the waterfall figure:
-experiments/report/ladder_figure.py.
+itself: experiments/report/ladder_page.py; the per-trial data written beside it:
+experiments/report/ladder_data.py; the waterfall figure: experiments/report/ladder_figure.py.
 """
 
 from __future__ import annotations
@@ -217,18 +217,21 @@ def step_tests(
 
 def split_tests(values: pd.DataFrame, order: list[str], beside: list[str]) -> pd.DataFrame:
     """Each comparison of each competence measure split, in each test world, into its two parts
-    (step_split.split_step); a part whose rungs were not both tested in that world is in the
-    table without a test (no pairs)."""
-    values = values[values["seed"].isin(common_seeds(values, order)) | values["rung"].isin(beside)]
+    (step_split.split_step) on the seeds of the comparison it splits (`step_tests`); a part
+    whose rungs were not both tested in that world is in the table without a test (no
+    pairs)."""
+    ladder = values[values["seed"].isin(common_seeds(values, order))]
     tested = family(order, beside, [], False)
     rows: list[dict] = []
     for case in tested.drop_duplicates(["key", "kind", "from", "to", "world"]).to_dict("records"):
         a, b, key, world = case["from"], case["to"], case["key"], case["world"]
+        # The seeds of the step it splits (`step_tests`): a rung beside, all both hold.
+        table = ladder if case["kind"] in (STEP, WHOLE) else values
         split = step_split.split_step(
-            _series(values, a, key),
-            _series(values, b, key),
-            _series(values, a, key, world),
-            _series(values, b, key, world),
+            _series(table, a, key),
+            _series(table, b, key),
+            _series(table, a, key, world),
+            _series(table, b, key, world),
         )
         for part, result in split.items():
             rows.append({**case, "part": part} | result)
@@ -267,17 +270,21 @@ def levels(values: pd.DataFrame) -> pd.DataFrame:
 @dataclass(frozen=True)
 class LadderRead:
     """What `read_ladder` found: every trial's values (VALUE_COLUMNS), the headline measures,
-    each rung's own results, and the cross-evaluations not found."""
+    each rung's own results, who computed each trial in each world (ladder_data.provenance's
+    rows), and the cross-evaluations not found."""
 
     values: pd.DataFrame
     measures: list[Headline]
     own: dict[str, BatchResults]
+    provenance: pd.DataFrame
     missing: list[str]
 
 
 def read_ladder(rungs: list[Rung], beside: list[Rung] | None = None) -> LadderRead:
     """The rungs in ladder order and those beside it, read. ReportError (one line) for a rung
     that cannot be read, fewer than two rungs, or two rungs of one name."""
+    from experiments.report.ladder_data import provenance
+
     every = [*rungs, *(beside or [])]
     if len(rungs) < 2:
         raise ReportError("a ladder needs at least two rungs (NAME=DIR[:GROUP] each)")
@@ -286,9 +293,10 @@ def read_ladder(rungs: list[Rung], beside: list[Rung] | None = None) -> LadderRe
         raise ReportError(f"two rungs share a name: {', '.join(names)}")
     own = {r.name: rung_results(r) for r in every}
     measures = headline(Geometry.of(own[rungs[0].name]))
-    rows, missing = [], []
+    rows, missing, where = [], [], []
     for rung in every:
         rows += values_of(own[rung.name], rung.name, OWN, measures)
+        where.append(provenance(own[rung.name], rung.name, OWN))
         competence = [h for h in measures if h.key in COMPETENCE]
         for world in WORLDS:
             try:
@@ -297,5 +305,6 @@ def read_ladder(rungs: list[Rung], beside: list[Rung] | None = None) -> LadderRe
                 missing.append(f"{rung.name} in the {world} world: {exc}")
                 continue
             rows += values_of(tested, rung.name, world, competence)
+            where.append(provenance(tested, rung.name, world))
     values = pd.DataFrame(rows, columns=VALUE_COLUMNS)
-    return LadderRead(values, measures, own, missing)
+    return LadderRead(values, measures, own, pd.concat(where, ignore_index=True), missing)

@@ -1,8 +1,10 @@
 """The contact ladder's page (`playroom ladder NAME=DIR[:GROUP] ... --out DIR`): the tests of
 experiments/report/ladder.py written as one unit into DIR: ladder.md (the tables), ladder.csv
-(every test of the family, unrounded, both kinds of p and their Holm adjustments), ladder.json
-(every trial's values, every test, the family, the completeness check, the rungs) and
-ladder.png (the waterfall, experiments/report/ladder_figure.py)."""
+(every test of the family, unrounded, both kinds of p and their Holm adjustments),
+ladder-trials.csv (every trial's values in every world it was tested in, with the machine and
+commit that computed it: experiments/report/ladder_data.py), ladder.json (every trial's values,
+every test, the family, the completeness check, the rungs) and ladder.png (the waterfall,
+experiments/report/ladder_figure.py)."""
 
 from __future__ import annotations
 
@@ -17,12 +19,12 @@ from experiments import provenance, storage
 from experiments.analysis import step_split
 from experiments.analysis.results import BatchResults, check_out_dir
 from experiments.analysis.trial_tests import ALPHA, survives
-from experiments.report import ladder, rung_change
+from experiments.report import ladder, ladder_data, rung_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
 from experiments.report.pages import machines_text, p_value, seeds_text
 
-FILES = ("ladder.csv", "ladder.json", "ladder.png", "ladder.md")
+FILES = ("ladder.csv", ladder_data.FILE, "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}
 WORLDS_TABLE_TITLE = (
     "Every rung's agents in each world (normalised competence, mean over the trials of the "
@@ -59,7 +61,8 @@ def _cell(kind: str, row: dict) -> str:
     low, high = signed_text(kind, row["low"]), signed_text(kind, row["high"])
     text = f"{signed_text(kind, row['mean'])} [{low}, {high}]"
     if not math.isfinite(row["p"]):
-        return f"{text}, untested: every pair equal ({n})"
+        why = "fewer than 2 pairs" if n < 2 else "every pair equal"
+        return f"{text}, untested: {why} ({n})"
     t = _p_text(row["p"], row["p_holm"])
     rank = _p_text(row["p_rank"], row["p_rank_holm"]).replace("p ", "rank p ", 1)
     return f"{text}, {t}; {rank} ({n})"
@@ -244,6 +247,10 @@ def markdown(
         "",
         f"Written by `{command}`; statistics computed on {here}.",
         "",
+        f"Every trial's values, in every world it was tested in, with the machine and commit "
+        f"that computed it: [{ladder_data.FILE}]({ladder_data.FILE}), from which every number "
+        "here can be computed again.",
+        "",
         "Tests over trials, the agent the unit, paired by seed: each cell is the mean over seeds "
         "of the later rung minus the earlier [95% t interval], the paired t's two-sided p, the "
         "Wilcoxon signed-rank test's two-sided p (rank p), (pairs); * after a p where it "
@@ -328,8 +335,11 @@ def ladder_files(
         "not_tested": read.missing,
     }
     tests = pd.concat([steps.assign(part=ladder.STEP, world=ladder.OWN), splits], ignore_index=True)
+    keys = [h.key for h in measures]
+    trials = ladder_data.trial_table(values, read.provenance, keys)
     return {
         "ladder.csv": tests.to_csv(index=False).encode(),
+        ladder_data.FILE: trials.to_csv(index=False).encode(),
         "ladder.json": storage.json_bytes(record),
         "ladder.png": png_bytes(waterfall(measures, steps, levels, order)),
         "ladder.md": page.encode(),

@@ -17,7 +17,7 @@ from trial_batches import batch
 from experiments.analysis import step_split
 from experiments.analysis.trial_tests import holm
 from experiments.cli.main import main
-from experiments.report import ladder
+from experiments.report import ladder, ladder_data
 
 SEEDS = range(6)
 KEY = "competence_ring1"
@@ -96,10 +96,14 @@ def test_a_rung_beside_the_ladder_is_set_against_the_last_rung():
 
 
 def test_each_step_splits_into_both_tested_in_a_world_and_own_worlds_against_it():
-    values = _values(LEVELS)
-    splits = ladder.split_tests(values, ["A", "B", "C"], []).query("key == @KEY")
-    steps = ladder.step_tests(values, ["A", "B", "C"], [], _headline())
+    # A rung lacking a seed, and one beside the ladder: each split adds up to the step it
+    # splits, on that step's seeds (a rung beside: every seed it and the last rung hold).
+    levels = {**LEVELS, "D": {"own": 0.03, "kinematic": 0.05, "physical": 0.0}}
+    values = _values(levels, drop=("B", 3))
+    splits = ladder.split_tests(values, ["A", "B", "C"], ["D"]).query("key == @KEY")
+    steps = ladder.step_tests(values, ["A", "B", "C"], ["D"], _headline())
     assert set(splits["part"]) == {"both_in_world", "own_against_world"}
+    assert set(splits.loc[splits["to"] == "D", "n"]) == {6}
     for (a, b, world), rows in splits.groupby(["from", "to", "world"]):
         parts = rows.set_index("part")["mean"]
         step = steps[(steps["from"] == a) & (steps["to"] == b)]["mean"].iloc[0]
@@ -175,6 +179,18 @@ def test_the_page_writes_every_trials_values_and_every_test(batches, tmp_path, c
     assert (out / "ladder.png").stat().st_size > 0
     tests = pd.read_csv(out / "ladder.csv")
     assert {"key", "kind", "from", "to", "mean", "low", "high", "p", "n", "p_holm"} <= set(tests)
+    # Every trial in its own world, with who computed it (the trials' provenance.json).
+    trials = pd.read_csv(out / "ladder-trials.csv").query("tested == 'own'")
+    assert sorted(zip(trials["rung"], trials["seed"], strict=True)) == [
+        ("a", 0),
+        ("a", 1),
+        ("b", 0),
+        ("b", 1),
+    ]
+    assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}(\+dirty)?").all()
+    assert trials["computed_on"].str.contains("from iteration 0").all()
+    assert trials["evaluated_on"].ne("not recorded").all()
+    assert set(record["measures"]) <= set(trials.columns)
 
 
 def test_a_group_the_batch_does_not_hold_is_refused_in_one_line(batches, tmp_path, capsys):
@@ -242,13 +258,18 @@ def _read(values: pd.DataFrame, configs: dict[str, dict]) -> ladder.LadderRead:
     rung's config (`configs`: rung -> _config) and its backend's record."""
     own = {}
     for rung, config in configs.items():
-        results = batch(rung, list(SEEDS))
+        seeds = values.loc[(values["rung"] == rung) & (values["tested"] == "own"), "seed"]
+        results = batch(rung, sorted(set(seeds)))
         record = BACKENDS[config["trial"]["grasp"]]
         if config["trial"]["grasp"] == "physical" and not config["world"]["push_objects"]:
             record = {**record, "pushes": False}
         trials = results.trials.drop(columns=["pushes", "closed_form"]).assign(**record)
         own[rung] = dataclasses.replace(results, trials=trials, configs={rung: config})
-    return ladder.LadderRead(values, _headline(), own, [])
+    where = []
+    for rung, tested in values[["rung", "tested"]].drop_duplicates().itertuples(index=False):
+        seeds = set(values.loc[(values["rung"] == rung) & (values["tested"] == tested), "seed"])
+        where.append(ladder_data.provenance(own[rung].with_seeds(seeds), rung, tested))
+    return ladder.LadderRead(values, _headline(), own, pd.concat(where), [])
 
 
 def test_the_page_gives_a_rank_p_beside_every_t_and_names_the_cells_whose_star_differs():
@@ -316,3 +337,63 @@ def test_one_order_is_worded_as_each_rule_given_the_rules_before_it():
     levels = ladder.levels(read.values)
     figure = waterfall(_headline(), steps, levels, ["A", "B", "C"])
     assert "given the rules before it" in figure.get_suptitle()
+
+
+def _recomputed(trials: pd.DataFrame, case: dict, seeds: set[int]) -> dict:
+    """A test of the page computed from the per-trial data alone, with scipy: B minus A on the
+    given seeds, pairs with an empty cell left out."""
+    from scipy import stats
+
+    def values(rung: str, tested: str) -> pd.Series:
+        mine = trials[(trials["rung"] == rung) & (trials["tested"] == tested)]
+        return mine.set_index("seed")[case["key"]].loc[lambda v: v.index.isin(seeds)]
+
+    a, b = case["from"], case["to"]
+    if case["part"] == "step":
+        diff = values(b, "own") - values(a, "own")
+    elif case["part"] == "both_in_world":
+        diff = values(b, case["world"]) - values(a, case["world"])
+    else:
+        w = case["world"]
+        diff = (values(b, "own") - values(b, w)) - (values(a, "own") - values(a, w))
+    d = diff.dropna().to_numpy()
+    half = stats.t.ppf(0.975, len(d) - 1) * stats.sem(d)
+    return {
+        "mean": d.mean(),
+        "low": d.mean() - half,
+        "high": d.mean() + half,
+        "p": stats.ttest_1samp(d, 0.0).pvalue,
+        "p_rank": stats.wilcoxon(d, zero_method="pratt").pvalue,
+        "n": len(d),
+    }
+
+
+def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alone():
+    """ladder-trials.csv, the data published beside the page, holds all a reader needs: each
+    test's mean, interval, t and signed-rank p, and each rung's mean, computed from it with
+    scipy alone, are the page's (a rung lacking a seed and a rung beside the ladder included)."""
+    from experiments.report.ladder_page import ladder_files
+
+    levels = {**LEVELS, "D": {"own": 0.03, "kinematic": 0.05, "physical": 0.0}}
+    values = _values(levels, drop=("B", 3))
+    configs = {r: _config("kinematic") for r in levels}
+    rungs = [ladder.Rung(r, Path(r)) for r in ("A", "B", "C")]
+    files = ladder_files(_read(values, configs), rungs, [ladder.Rung("D", Path("D"))], "cmd")
+    trials = pd.read_csv(io.BytesIO(files[ladder_data.FILE]))
+    tests = pd.read_csv(io.BytesIO(files["ladder.csv"]))
+    page = files["ladder.md"].decode()
+    own = trials[trials["tested"] == "own"]
+    ladder_seeds = set.intersection(*(set(own.loc[own["rung"] == r, "seed"]) for r in "ABC"))
+    every = set(own["seed"])
+    made = tests[tests["p"].notna()].to_dict("records")
+    assert {r["kind"] for r in made} == {"step", "whole", "whole_all", "beside"}
+    for case in made:
+        seeds = ladder_seeds if case["kind"] in ("step", "whole") else every
+        again = _recomputed(trials, case, seeds)
+        for column, value in again.items():
+            assert case[column] == pytest.approx(value, rel=1e-9), (case, column)
+        if case["part"] == "step":
+            assert f"{100 * again['mean']:+.1f} [{100 * again['low']:+.1f}, " in page
+    # The rungs' means the page shows: over the seeds every rung holds.
+    mean_a = own[(own["rung"] == "A") & own["seed"].isin(ladder_seeds)][KEY].mean()
+    assert f"| ring 1 | {100 * mean_a:.1f} |" in page
