@@ -52,7 +52,7 @@ def _p_text(p: float, adjusted: float) -> str:
     return p_value(p) + (" *" if survives(adjusted) else "")
 
 
-def _cell(kind: str, row: dict) -> str:
+def cell_text(kind: str, row: dict) -> str:
     """A difference as "+1.5 [-0.0, +3.0], p = 0.054; rank p = 0.061 (32)": the paired t's p,
     then the signed-rank test's, each * where it survives Holm over the page's family."""
     n = int(row["n"])
@@ -125,11 +125,11 @@ def steps_table(
         kind = h.measure.kind
         level = {r["rung"]: r["mean"] for r in _rows(levels, tested=ladder.OWN, key=h.key)}
         cells = [level_text(kind, level.get(order[0], math.nan))]
-        cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.STEP)]
+        cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=ladder.STEP)]
         cells.append(level_text(kind, level.get(order[-1], math.nan)))
-        cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.WHOLE)]
+        cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=ladder.WHOLE)]
         for which in (ladder.WHOLE_ALL, ladder.BESIDE):
-            cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=which)]
+            cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=which)]
         lines.append(f"| {h.label} | " + " | ".join(cells) + " |")
     return lines
 
@@ -152,7 +152,7 @@ def split_table(splits: pd.DataFrame, levels: pd.DataFrame) -> list[str]:
     seen = splits[["from", "to", "kind", "world", "part"]].drop_duplicates()
     for case in seen.to_dict("records"):
         by_key = {r["key"]: r for r in _rows(splits, case)}
-        cells = [_cell("share", by_key[k]) if k in by_key else "" for k in keys]
+        cells = [cell_text("share", by_key[k]) if k in by_key else "" for k in keys]
         step = f"{case['from']} -> {case['to']}" + (
             " (whole)" if case["kind"] == ladder.WHOLE else ""
         )
