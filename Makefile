@@ -103,8 +103,9 @@ contact-ablations: comparison-diva
 ## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
 ## DIVA, every agent tested in both worlds; rungs 0 and 5 are comparison-diva's halves); a
 ## rung that is a contact ablation (the same batch) runs into that ablation's directory. Then
-## `playroom ladder`: each step paired by seed, the steps' sum against the whole difference,
-## the cross-evaluation's split, Holm over every test (ladder.md/.csv/.json/.png). Resumes
+## `playroom ladder`: each step (its rule given the rules before it) paired by seed, with the
+## paired t's and the signed-rank p, the cross-evaluation's split, Holm over the page's declared
+## family, a completeness check (ladder.md/.csv/.json/.png, ladder-trials.csv). Resumes
 CONTACT_LADDER := $(basename $(notdir $(wildcard experiments/batches/contact-ladder/*.json)))
 contact-ladder: comparison-diva
 	for rung in $(CONTACT_LADDER); do \
