@@ -9,7 +9,7 @@ OUT ?= runs
 # installing the package into their own environment); `make lock` regenerates it.
 LOCK := constraints.txt
 
-.PHONY: install install-rl lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder ablations rl-baseline rl-control rl-race clean
+.PHONY: install install-rl lock run test test-slow lint format bench voice-model experiment compare video replicate replicate-diva comparison comparison-diva contact-ablations contact-ladder contact-unbundled held-pose-returns contact-factorial ablations rl-baseline rl-control rl-race clean
 
 $(INSTALLED): pyproject.toml $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -103,8 +103,9 @@ contact-ablations: comparison-diva
 ## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
 ## DIVA, every agent tested in both worlds; rungs 0 and 5 are comparison-diva's halves); a
 ## rung that is a contact ablation (the same batch) runs into that ablation's directory. Then
-## `playroom ladder`: each step paired by seed, the steps' sum against the whole difference,
-## the cross-evaluation's split, Holm over every test (ladder.md/.csv/.json/.png). Resumes
+## `playroom ladder`: each step (its rule given the rules before it) paired by seed, with the
+## paired t's and the signed-rank p, the cross-evaluation's split, Holm over the page's declared
+## family, a completeness check (ladder.md/.csv/.json/.png, ladder-trials.csv). Resumes
 CONTACT_LADDER := $(basename $(notdir $(wildcard experiments/batches/contact-ladder/*.json)))
 contact-ladder: comparison-diva
 	for rung in $(CONTACT_LADDER); do \
@@ -121,6 +122,64 @@ contact-ladder: comparison-diva
 		no-push=$(OUT)/contact-ablation-no-push \
 		physical=$(OUT)/comparison-diva:physical \
 		--beside settle=$(OUT)/contact-ablation-settle --out $(OUT)/contact-ladder
+
+## contact-unbundled: after `make contact-ladder`, the ladder's contact step in four rungs
+## (experiments/batches/contact-unbundled/*.json, 32 seeds x 80000 with DIVA, both eval worlds:
+## clear placements, the contact's reach alone, obstruction; then the ladder's contact-aligned
+## rung, whose step is the caregiver's welded carrying), then `playroom ladder` of the whole
+## ladder with them into $(OUT)/contact-unbundled. Resumes
+CONTACT_UNBUNDLED := $(basename $(notdir $(wildcard experiments/batches/contact-unbundled/*.json)))
+contact-unbundled: contact-ladder
+	for rung in $(CONTACT_UNBUNDLED); do \
+		$(BIN)/playroom batch --config experiments/batches/contact-unbundled/$$rung.json \
+			--out $(OUT)/contact-unbundled-$$rung || exit 1; \
+	done
+	$(BIN)/playroom ladder kinematic=$(OUT)/comparison-diva:kinematic \
+		held-stick-catch=$(OUT)/contact-ladder-01-held-stick-catch \
+		servo-arm=$(OUT)/contact-ladder-02-servo-arm \
+		clear-placements=$(OUT)/contact-unbundled-01-clear-placements \
+		contact-reach=$(OUT)/contact-unbundled-02-contact-reach \
+		obstruction=$(OUT)/contact-unbundled-03-obstruction \
+		contact-aligned=$(OUT)/contact-ladder-03-contact-aligned \
+		no-push=$(OUT)/contact-ablation-no-push \
+		physical=$(OUT)/comparison-diva:physical \
+		--beside settle=$(OUT)/contact-ablation-settle --out $(OUT)/contact-unbundled
+
+## held-pose-returns: the ladder's held-pose step with the stick returned at the contact limit
+## on both sides (experiments/batches/held-pose-returns/, 32 seeds), its two-rung page
+held-pose-returns: $(INSTALLED)
+	for side in aligned touch; do \
+		$(BIN)/playroom batch --config experiments/batches/held-pose-returns/$$side.json \
+			--out $(OUT)/held-pose-returns-$$side || exit 1; \
+	done
+	$(BIN)/playroom ladder aligned=$(OUT)/held-pose-returns-aligned \
+		touch=$(OUT)/held-pose-returns-touch --out $(OUT)/held-pose-returns
+
+## contact-factorial: after `make contact-ladder`, the cells the ladder lacks of three 2 x 2
+## designs (experiments/batches/contact-factorial/*.json, 16 seeds x 80000 with DIVA), then
+## `playroom factorial` of each: held pose x pushing, catch rule x servo arm, catch rule x the
+## contact's catch distance, into $(OUT)/contact-factorial-*. Resumes
+CONTACT_FACTORIAL := $(basename $(notdir $(wildcard experiments/batches/contact-factorial/*.json)))
+contact-factorial: contact-ladder
+	for cell in $(CONTACT_FACTORIAL); do \
+		$(BIN)/playroom batch --config experiments/batches/contact-factorial/$$cell.json \
+			--out $(OUT)/contact-factorial-$$cell || exit 1; \
+	done
+	$(BIN)/playroom factorial aligned=$(OUT)/contact-ladder-03-contact-aligned \
+		touch=$(OUT)/contact-ablation-no-push aligned-push=$(OUT)/contact-factorial-aligned-push \
+		physical=$(OUT)/comparison-diva:physical --factors "held pose of the touch" pushing \
+		--out $(OUT)/contact-factorial-held-pose-pushing
+	$(BIN)/playroom factorial kinematic=$(OUT)/comparison-diva:kinematic \
+		held-stick-catch=$(OUT)/contact-ladder-01-held-stick-catch \
+		study-catch-servo=$(OUT)/contact-factorial-study-catch-servo \
+		servo-arm=$(OUT)/contact-ladder-02-servo-arm \
+		--factors "held-stick catch" "servo arm" --out $(OUT)/contact-factorial-catch-servo
+	$(BIN)/playroom factorial kinematic=$(OUT)/comparison-diva:kinematic \
+		held-stick-catch=$(OUT)/contact-ladder-01-held-stick-catch \
+		study-catch-near=$(OUT)/contact-factorial-study-catch-near \
+		held-catch-near=$(OUT)/contact-factorial-held-catch-near \
+		--factors "held-stick catch" "catch distance 0.055 m" \
+		--out $(OUT)/contact-factorial-catch-distance
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the

@@ -38,6 +38,10 @@ from experiments.log_layout import identity_text, trial_identity
 CHECKSUM_KEY = "checksum"
 # eval.json's entry of the identity of the trial evaluated ({"seed", "config"}).
 IDENTITY_KEY = "trial_identity"
+# eval.json's entry saying its scenes were placed clear of the stick (`playroom eval
+# --scenes-clear-of-stick`, experiments/measure/evaluation.py), written only then: an
+# evaluation of the default scenes is the file it always was.
+SCENES_KEY = "scenes_clear_of_stick"
 
 
 def evaluation_json(summary: dict, config: dict) -> bytes:

@@ -31,6 +31,8 @@ DMP_KINDS = ("study", "project")  # sim/dmp.py
 CATCH_RULES = ("study", "held_stick")  # sim/grasping/kinematic.py
 ARM_DYNAMICS = ("set", "servo")  # sim/grasping/kinematic.py, sim/arm_servo.py
 HELD_POSES = ("touch", "aligned")  # sim/grasping/physical.py
+UNHELD_CONTACTS = ("solid", "sensed")  # sim/physics.py
+CAREGIVER_CARRYING = ("welded", "placed")  # sim/grasping/carrying.py
 STICK_RETURNS = ("never", "out_of_reach")  # sim/experimenter.py
 N_RINGS = 3  # the study's rings; evaluations and reports name them ring1..ring3
 # With push_objects off: the table damping of an unheld object (20 on x, y in the MJCF) times
@@ -41,6 +43,13 @@ UNPUSHED_DAMPING_FACTOR = 1e4
 # overlapping parted within the next movement's first 5 control steps (50 physics steps) in 15
 # of 16 cases seen (random commands, seed 3, study preset); twice that.
 SETTLE_PHYSICS_STEPS = 100
+# With unheld_contacts "sensed": every object geom's contact margin (m) and gap (m). MuJoCo finds
+# a contact where the geoms' distance is below margin + gap and lets it act only below margin:
+# -1 + 1 finds a contact where the geoms touch, as the solid room does (the grasp's contact
+# sensors count it the same), and no touch ever acts (1 m of overlap never happens on this
+# table).
+SENSED_CONTACT_MARGIN = -1.0
+SENSED_CONTACT_GAP = 1.0
 
 # The key of a field's metadata that holds the value every trial written before the field
 # existed ran with: a field added to a released config declares it beside itself, so that
@@ -137,6 +146,32 @@ class WorldConfig:
     held_pose: str = dataclasses.field(
         default="touch", metadata={BEFORE: "touch", ACTS_ON: ("physical",)}
     )
+    # A part of the contact step unbundled (issue 51), never a default: what the physical
+    # backend's objects do where something touches them. "solid": they push back (pushed, or
+    # held still by the table with push_objects false: then they block the hand and what it
+    # holds); "sensed": the touch is found, and the grasp's contact sensors read it as they
+    # read any touch, but no contact between objects or with the hand exerts a force
+    # (SENSED_CONTACT_MARGIN, SENSED_CONTACT_GAP): the contact's reach alone, nothing blocked
+    # or pushed, as under the kinematic rules. Older trials: "solid".
+    unheld_contacts: str = dataclasses.field(
+        default="solid", metadata={BEFORE: "solid", ACTS_ON: ("physical",)}
+    )
+    # A part of the contact step unbundled (issue 51), never a default: how the physical
+    # backend's caregiver carries the toy she brings. "welded": her hand, a mocap body, welded
+    # to the toy, which follows it through the dynamics (sim/grasping/carrying.py); "placed":
+    # the toy itself put at each control step's point of her path, as the kinematic rules
+    # place it. Either way it is lifted and touches nothing while carried. Older trials: welded.
+    caregiver_carrying: str = dataclasses.field(
+        default="welded", metadata={BEFORE: "welded", ACTS_ON: ("physical",)}
+    )
+    # A part of the contact step unbundled (issue 51), never a default: True places the
+    # kinematic backend's toys as the physical backend must place its solid ones, each clear
+    # of the others and of the stick (sim/experimenter.py PLACEMENT_CLEARANCE); False places
+    # them anywhere in their rings, as the study did. The physical backend always places clear.
+    # Older trials: False.
+    placements_clear: bool = dataclasses.field(
+        default=False, metadata={BEFORE: False, ACTS_ON: ("kinematic",)}
+    )
 
     def __post_init__(self) -> None:
         """Every field checked when the config is built (ValueError, one line): a typo or a
@@ -167,7 +202,9 @@ class WorldConfig:
         check_choice(w + "voice", self.voice, TRACTS)
         check_choice(w + "arm_dynamics", self.arm_dynamics, ARM_DYNAMICS)
         check_choice(w + "held_pose", self.held_pose, HELD_POSES)
-        for name in ("push_objects", "settle_between_movements"):
+        check_choice(w + "unheld_contacts", self.unheld_contacts, UNHELD_CONTACTS)
+        check_choice(w + "caregiver_carrying", self.caregiver_carrying, CAREGIVER_CARRYING)
+        for name in ("push_objects", "settle_between_movements", "placements_clear"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"{w}{name} must be true or false, got {getattr(self, name)!r}")
 

@@ -36,7 +36,9 @@ class Experimenter:
         self.config = config
         self.physics = physics
         self.backend = backend
-        self.solid = backend.solid  # solid objects: placements keep clear of each other
+        # Placements keep clear of each other and of the stick: solid objects must; the
+        # kinematic rules do where the world says so (WorldConfig.placements_clear).
+        self.clear = backend.solid or config.placements_clear
         m = physics.model.ptr
         self.toy_radius = float(m.geom_size[physics.toy_geoms[0], 0])
         # The thickest part of the stick (its tip sphere), measured from the handle-tip line.
@@ -50,13 +52,14 @@ class Experimenter:
     # Toys ---------------------------------------------------------------------------------
     def place_toys(self, rng: np.random.Generator) -> None:
         """Each toy picks one of the rings with equal chance, a uniform radius in it and a
-        uniform angle (solid toys draw again until clear of the others and of the stick)."""
+        uniform angle (placed clear, `clear`: drawn again until clear of the others and of the
+        stick)."""
         p = self.physics
         poses = p.object_poses()
         for i in range(len(TOYS)):
             while True:
                 position = self._random_ring_position(rng)
-                if not self.solid or self._toy_fits(position, poses, i):
+                if not self.clear or self._toy_fits(position, poses, i):
                     break
             poses[1 + i] = (*position, 0.0)
         p.set_object_poses(poses)
@@ -74,9 +77,11 @@ class Experimenter:
             if np.linalg.norm(position - poses[1 + j, :2]) < self.min_toy_gap:
                 return False
         p = self.physics
-        return self._clear_of_stick(position, p.stick_handle(), p.stick_tip())
+        return self.clear_of_stick(position, p.stick_handle(), p.stick_tip())
 
-    def _clear_of_stick(self, position: np.ndarray, handle: np.ndarray, tip: np.ndarray) -> bool:
+    def clear_of_stick(self, position: np.ndarray, handle: np.ndarray, tip: np.ndarray) -> bool:
+        """Whether a toy at `position` keeps PLACEMENT_CLEARANCE from a stick lying from
+        `handle` to `tip` (its thickest part, the tip sphere, taken all along)."""
         clearance = self.toy_radius + self.stick_radius + PLACEMENT_CLEARANCE
         return segment_distance(position, handle, tip) >= clearance
 
@@ -86,17 +91,22 @@ class Experimenter:
         backend says when: sim/grasping/)."""
         return self.backend.stick_out_of_reach(self.physics)
 
+    def start_stick(self) -> tuple[np.ndarray, np.ndarray]:
+        """(handle, tip) of the stick at its start pose (m)."""
+        cfg = self.config
+        handle = np.array(cfg.stick_start_handle)
+        direction = np.array([np.cos(cfg.stick_start_angle), np.sin(cfg.stick_start_angle)])
+        return handle, handle + cfg.stick_length * direction
+
     def return_stick_if_lost(self) -> list[ev.Event]:
         """With stick_return 'out_of_reach': a lost stick back at its start pose, if no toy
         lies there now (then at the end of a later iteration, the toys having moved)."""
         if self.config.stick_return != "out_of_reach" or not self.stick_lost():
             return []
         cfg, p = self.config, self.physics
-        handle = np.array(cfg.stick_start_handle)
-        direction = np.array([np.cos(cfg.stick_start_angle), np.sin(cfg.stick_start_angle)])
-        tip = handle + cfg.stick_length * direction
+        handle, tip = self.start_stick()
         toys = p.toy_positions()
-        if self.solid and not all(self._clear_of_stick(t, handle, tip) for t in toys):
+        if self.clear and not all(self.clear_of_stick(t, handle, tip) for t in toys):
             return []
         poses = p.object_poses()
         poses[0] = (*cfg.stick_start_handle, cfg.stick_start_angle)

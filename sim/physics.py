@@ -9,7 +9,13 @@ import numpy as np
 
 from models import playroom_xml
 from models.layout import TOYS
-from sim.config import DEFAULT_WORLD, UNPUSHED_DAMPING_FACTOR, WorldConfig
+from sim.config import (
+    DEFAULT_WORLD,
+    SENSED_CONTACT_GAP,
+    SENSED_CONTACT_MARGIN,
+    UNPUSHED_DAMPING_FACTOR,
+    WorldConfig,
+)
 from sim.dm_control_import import dm_mujoco
 from sim.mujoco_import import mujoco
 
@@ -59,6 +65,12 @@ class PlayroomPhysics(dm_mujoco.Physics):
             # (sim/model_edits.py), and the integrator treats damping implicitly, so this
             # stays stable however large.
             physics.model.ptr.dof_damping[physics.object_dof.ravel()] *= UNPUSHED_DAMPING_FACTOR
+        if config.unheld_contacts == "sensed":
+            # Touches found where the geoms touch, none acting (WorldConfig.unheld_contacts):
+            # every contact of this room is an object's (the hand's are with objects only).
+            objects = [*physics.stick_geoms, *physics.toy_geoms]
+            physics.model.ptr.geom_margin[objects] = SENSED_CONTACT_MARGIN
+            physics.model.ptr.geom_gap[objects] = SENSED_CONTACT_GAP
         mismatches = physics.disagreements_with(config)
         if mismatches:
             raise ValueError(
@@ -269,6 +281,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
         positions: np.ndarray,
         watched: np.ndarray,
         trace: MovementTrace | None = None,
+        moved: np.ndarray | None = None,
     ) -> int:
         """Control steps `start`, `start` + 1, ... of a movement in compiled code, each
         CONTROL_SUBSTEPS physics steps taken as `advance` takes them: before each, the servos'
@@ -279,7 +292,9 @@ class PlayroomPhysics(dm_mujoco.Physics):
         and nothing brought, the steps after one that leaves the room's state as it found it
         (all at rest) are not computed: only the time moves (sim.compiled_steps). Only where
         sim.compiled_steps.AVAILABLE. Where `trace` is given, its rows k + 1 take the joints' and
-        the mocap bodies' positions after each step k."""
+        the mocap bodies' positions after each step k. `moved`: what her path sets (a view of
+        the data, its first two numbers x, y: the caregiver's carrying says which,
+        sim/grasping/carrying.py); None, her hand."""
         from sim.compiled_steps import DYNAMIC_STATE, control_steps, disable_flags_view
 
         if not positions.flags.c_contiguous:  # its rows are written through a flat view
@@ -298,7 +313,7 @@ class PlayroomPhysics(dm_mujoco.Physics):
             arm_targets,
             d.ctrl,
             _NOT_BROUGHT if brought is None else brought,
-            self._caregiver_hand_row,
+            self._caregiver_hand_row if moved is None else moved,
             self._site_xpos_flat,
             self._hand_handle_flat,
             self._xpos_flat,

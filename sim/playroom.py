@@ -287,6 +287,6 @@ def compose_backend(
     and the grasp rule where it is a part of its own; all edit the model through one
     ModelEdits."""
     edits = ModelEdits(physics)
-    carrying = backend.carrying_class(edits)
+    carrying = backend.carrying_for(config)(edits)
     rule = None if backend.rule_class is None else backend.rule_class(config, edits, backend.name)
     return backend(config, edits, carrying, rule)

@@ -31,6 +31,7 @@ from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
 from experiments.backend_record import CAPABILITIES
 from experiments.config_file import with_added_settings
+from experiments.eval_record import SCENES_KEY
 from experiments.file_names import (
     COMPETENCE_FILE,
     CONFIG_FILE,
@@ -222,6 +223,12 @@ def _check_evaluations(label: str, trials: list[tuple[Path, dict, dict]]) -> Non
         raise ReportError(
             f"trials of group {label} were evaluated on different numbers of placements "
             f"({sorted(placements, key=str)}): evaluate them again with the same --placements"
+        )
+    clear = {bool(summary.get(SCENES_KEY, False)) for _, _, summary in trials}
+    if len(clear) > 1:
+        raise ReportError(
+            f"trials of group {label} were evaluated on different scenes, some with "
+            "--scenes-clear-of-stick and some without: evaluate them again alike"
         )
 
 

@@ -1,17 +1,16 @@
-"""One step between two conditions (two rungs of the contact ladder, or a condition and its
-ablation), split into what the agents learned and what the test world does, with a test over
-trials paired by seed.
+"""Steps between conditions (two rungs of the contact ladder, or a condition and its ablation),
+each split by the world that tests the agents, with tests over trials paired by seed: the split
+and the tests are experiments/analysis/step_split.py's, the ones the ladder's page uses.
 
 For conditions A and B (batch directories of the same seeds), from their own evaluations and
-their evaluations in other eval worlds (`playroom eval DIR --world`, eval_worlds.py):
-- the whole step: B's agents in B's own world against A's in A's own (what the comparison
-  reports);
-- what the agents learned: B's agents against A's, both tested in the same world (each test
-  world both were tested in; a condition's own world counts as the world it equals);
-- what the test world does: B's agents in B's own world against B's agents in A's world.
-Each difference is the mean over seeds of B minus A, with its Student t 95% interval and the
-paired t test's two-sided p (scipy.stats.ttest_rel): the unit is the agent. Holm's correction
-over every test printed marks those that survive.
+their evaluations in other eval worlds (`playroom eval DIR --world`, eval_worlds.py): the whole
+step (each in its own world), and for each test world both were tested in, both tested there
+(B in it - A in it) and each one's own world against it ((B own - B in it) - (A own - A in
+it)); the two parts add up to the whole. Each difference: the mean over seeds of B minus A,
+its Student t 95% interval, the paired t test's two-sided p and the Wilcoxon signed-rank p.
+The family is every test printed (each step given on the command line x its parts x the
+competence measures); Holm's correction over it, for each kind of p, marks with * those that
+survive, and the rows whose star differs between the two are listed after the table.
 
     python -m experiments.analysis.world_steps NAME=BATCH_DIR NAME=BATCH_DIR ... --steps A:B ...
 """
@@ -22,14 +21,13 @@ import argparse
 import math
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
-from scipy import stats
 
 from experiments import storage
-from experiments.analysis import trial_tests
+from experiments.analysis import step_split
 from experiments.analysis.cross_worlds import RINGS, STRATEGIES, checked_summary, tested_in
 from experiments.analysis.logs import trial_dirs
+from experiments.analysis.trial_tests import ALPHA, survives
 from experiments.config_file import with_added_settings
 from experiments.file_names import CONFIG_FILE
 
@@ -68,61 +66,31 @@ def evaluations(conditions: dict[str, Path], check: bool = True) -> pd.DataFrame
     return pd.DataFrame(rows)
 
 
-def paired(
-    table: pd.DataFrame, a: tuple[str, str], b: tuple[str, str], measure: str
-) -> dict[str, float]:
-    """B minus A over the seeds both hold ((condition, tested) each): mean, 95% interval, the
-    paired t test's p, n."""
-
-    def values(key: tuple[str, str]) -> pd.Series:
-        rows = table[(table["condition"] == key[0]) & (table["tested"] == key[1])]
-        return rows.set_index("seed")[measure]
-
-    both = pd.concat([values(a), values(b)], axis=1, keys=["a", "b"]).dropna()
-    diff = (both["b"] - both["a"]).to_numpy()
-    n = len(diff)
-    if n < 2:
-        return {"mean": math.nan, "low": math.nan, "high": math.nan, "p": math.nan, "n": n}
-    half = stats.t.ppf(0.975, n - 1) * diff.std(ddof=1) / math.sqrt(n)
-    p = float(stats.ttest_rel(both["b"], both["a"]).pvalue) if np.any(diff) else 1.0
-    mean = float(diff.mean())
-    return {"mean": mean, "low": mean - half, "high": mean + half, "p": p, "n": n}
+def _series(table: pd.DataFrame, condition: str, tested: str, measure: str) -> pd.Series:
+    rows = table[(table["condition"] == condition) & (table["tested"] == tested)]
+    return rows.set_index("seed")[measure]
 
 
 def step_rows(table: pd.DataFrame, a: str, b: str, measures=MEASURES) -> list[dict]:
-    """The whole step from A to B, what the agents learned (in each world both were tested
-    in) and what the test world does (B in its own world against B in A's), per measure."""
+    """The whole step from A to B and, in each test world both were tested in, its two parts
+    (step_split.split_step), per measure."""
     held = set(map(tuple, table[["condition", "tested"]].drop_duplicates().to_numpy()))
-    parts = [("whole step (own worlds)", (a, OWN), (b, OWN))]
-    for world in WORLDS:
-        a_in = (a, world) if (a, world) in held else None
-        b_in = (b, world) if (b, world) in held else None
-        if a_in and b_in:
-            parts.append((f"learned (both tested in the {world} world)", a_in, b_in))
-    a_world = _own_world(table, a)
-    if a_world is not None and (b, a_world) in held:
-        parts.append((f"test world ({b} in its own against in {a_world})", (b, a_world), (b, OWN)))
-    return [
-        {"step": f"{a} -> {b}", "part": part, "measure": m, **paired(table, x, y, m)}
-        for part, x, y in parts
-        for m in measures
-    ]
+    worlds = [w for w in WORLDS if (a, w) in held and (b, w) in held]
+    rows = []
+    for m in measures:
+        a_own, b_own = _series(table, a, OWN, m), _series(table, b, OWN, m)
+        parts = [(step_split.PART_TEXT[step_split.WHOLE], step_split.paired_test(b_own, a_own))]
+        for world in worlds:
+            a_in, b_in = _series(table, a, world, m), _series(table, b, world, m)
+            split = step_split.split_step(a_own, b_own, a_in, b_in)
+            parts += [(step_split.PART_TEXT[k].format(world=world), t) for k, t in split.items()]
+        rows += [{"step": f"{a} -> {b}", "part": p, "measure": m, **t} for p, t in parts]
+    return rows
 
 
-def _own_world(table: pd.DataFrame, condition: str) -> str | None:
-    """The test world a condition's own world equals (its own rows equal that world's), if any."""
-    mine = table[table["condition"] == condition]
-    own = mine[mine["tested"] == OWN].set_index("seed")[list(MEASURES)]
-    for world in WORLDS:
-        there = mine[mine["tested"] == world].set_index("seed")[list(MEASURES)]
-        if len(there) and there.equals(own.loc[there.index]):
-            return world
-    return None
-
-
-def holm(p: pd.Series) -> pd.Series:
-    """Holm's step-down adjusted p-values (NaN left out): trial_tests.holm, by index."""
-    return pd.Series(trial_tests.holm(p.astype(float).tolist()), index=p.index)
+def _p_text(p: float, adjusted: float) -> str:
+    mark = " *" if survives(adjusted) else ""
+    return "n/a" if math.isnan(p) else f"{p:.2g}{mark}"
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -142,20 +110,30 @@ def main(argv: list[str] | None = None) -> None:
     if args.eval_json_only:
         print("eval.json read without checking the tables it lists (--eval-json-only)")
     rows = pd.DataFrame([r for s in args.steps for r in step_rows(table, *s.split(":", 1))])
-    rows["p_holm"] = holm(rows["p"])
+    (rows,) = step_split.with_holm(rows)
     if args.csv:
         rows.to_csv(args.csv, index=False)
-    print(f"{len(rows)} tests, paired by seed; * survives Holm's correction at 0.05")
-    print("| step | part | measure | B - A (points) | 95% interval | p | n |")
-    print("|---|---|---|---|---|---|---|")
-    for r in rows.to_dict("records"):
-        mark = " *" if float(r["p_holm"]) < 0.05 else ""
-        p = "n/a" if math.isnan(float(r["p"])) else f"{float(r['p']):.2g}{mark}"
+    n = step_split.counts([rows])
+    print(
+        f"{n['family']} tests, paired by seed ({n['made']} made: every difference equal is no "
+        f"test); * survives Holm's correction over all of them at {ALPHA} ({n['t']} with the "
+        f"paired t, {n['rank']} with the signed-rank test)"
+    )
+    print("| step | part | measure | B - A (points) | 95% interval | t p | signed-rank p | n |")
+    print("|---|---|---|---|---|---|---|---|")
+    records = rows.to_dict("records")
+    for r in records:
         low, high = 100 * float(r["low"]), 100 * float(r["high"])
         print(
             f"| {r['step']} | {r['part']} | {str(r['measure']).removeprefix('competence_')} | "
-            f"{100 * float(r['mean']):+.1f} | [{low:+.1f}, {high:+.1f}] | {p} | {r['n']} |"
+            f"{100 * float(r['mean']):+.1f} | [{low:+.1f}, {high:+.1f}] | "
+            f"{_p_text(float(r['p']), float(r['p_holm']))} | "
+            f"{_p_text(float(r['p_rank']), float(r['p_rank_holm']))} | {r['n']} |"
         )
+    differ = [r for r in records if step_split.stars_differ(r)]
+    print(f"Stars that differ between the t and the signed-rank test: {len(differ)}")
+    for r in differ:
+        print(f"- {r['step']}, {r['part']}, {r['measure']}")
 
 
 if __name__ == "__main__":

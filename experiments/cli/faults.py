@@ -154,6 +154,7 @@ KEPT: dict[str, Callable[[argparse.Namespace, list[str], str], str]] = {
     "compare": _nothing_written,
     "ablations": _nothing_written,
     "ladder": _nothing_written,
+    "factorial": _nothing_written,
     "rl-baseline": _baseline_kept,
     "rl-compare": _nothing_written,
     "replay": _nothing_written,

@@ -24,11 +24,14 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="rungs from one world to another, each step paired by seed",
         description="Rungs in ladder order, each a batch directory (DIR:GROUP for one group of "
         "a batch of both backends, e.g. comparison-diva:kinematic), one rule changed "
-        "per rung: each step's difference per measure, paired by seed, the whole difference "
-        "and the steps' sum, and where the rungs' agents were tested in both worlds "
-        "(`playroom eval DIR --world W`) what each step's agents learned and what the test "
-        "worlds do; Holm's correction over every test. Writes ladder.md, ladder.csv, "
-        "ladder.json and ladder.png into --out.",
+        "per rung: each step's difference per measure (the rule's effect given the rules "
+        "before it), paired by seed, with the paired t's and the signed-rank test's p, the "
+        "whole difference, and where the rungs' agents were tested in both worlds "
+        "(`playroom eval DIR --world W`) each step with both rungs' agents tested in one "
+        "world and their own worlds against it; Holm's correction over the page's one family "
+        "of tests; a check that every rung holds every seed and world. Writes ladder.md, "
+        "ladder.csv (every test), ladder-trials.csv (every trial's values in every world, "
+        "with the machine and commit that computed it), ladder.json and ladder.png into --out.",
     )
     p.add_argument(
         "rungs",
@@ -68,4 +71,4 @@ def cmd_ladder(args: argparse.Namespace) -> None:
     except ReportError as exc:
         raise UsageError(str(exc)) from None
     print(page.read_text(), end="")
-    print(f"written: {page}, ladder.csv, ladder.json, ladder.png")
+    print(f"written: {page}, ladder.csv, ladder-trials.csv, ladder.json, ladder.png")

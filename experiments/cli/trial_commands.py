@@ -99,6 +99,14 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         "--placements", type=positive_int, default=100, help="toy placements tested per ring"
     )
     p.add_argument(
+        "--scenes-clear-of-stick",
+        action="store_true",
+        help="a proposed departure, never the default: place every test scene's toys clear of "
+        "the stick at its start, as the physical backend's learning placements are (by default "
+        "some ring-1 scenes start with a toy on the stick: docs/protocol.md D20); eval.json "
+        "says so",
+    )
+    p.add_argument(
         "--world",
         choices=WORLD_NAMES,
         default=OWN,
@@ -193,7 +201,9 @@ def cmd_eval(args: argparse.Namespace) -> None:
     try:
         summary = evaluate_trial(
             args.dir,
-            EvaluationSettings(n_placements=args.placements),
+            EvaluationSettings(
+                n_placements=args.placements, scenes_clear_of_stick=args.scenes_clear_of_stick
+            ),
             progress=not args.quiet,
             notify=lambda line: print(f"playroom eval: {line}", file=sys.stderr, flush=True),
             world=args.world,

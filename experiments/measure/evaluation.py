@@ -18,6 +18,8 @@ JSON: a number that is not finite (a best distance before any voice movement) is
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,12 +39,22 @@ GOAL_TIMES = np.array([0.0, 0.3, 0.5, 0.8, 1.0])
 # Evaluation placements come from their own seed, the same for every trial and backend, so
 # that trials are compared on identical tests.
 EVAL_SEED = 20170000
+# The stream of the evaluation seed that scenes clear of the stick draw a toy again from (a
+# ring's own: its inner radius in mm beside it), apart from the scenes' own draws.
+REDRAW_STREAM = 1
 
 
 @dataclass(frozen=True)
 class EvaluationSettings:
+    """n_placements: placements per ring; seed: of the placements and caregivers.
+    scenes_clear_of_stick: a proposed departure (docs/protocol.md D20), never a default: every
+    toy of a scene placed clear of the stick at its start pose, as the physical backend's
+    learning placements are (sim/experimenter.py), instead of only clear of the other toys.
+    The default keeps the evaluation every published number came from."""
+
     n_placements: int = 100
     seed: int = EVAL_SEED
+    scenes_clear_of_stick: bool = False
 
 
 def goal_trajectory(toy: np.ndarray) -> np.ndarray:
@@ -51,23 +63,59 @@ def goal_trajectory(toy: np.ndarray) -> np.ndarray:
     return np.concatenate([points[:, 0], points[:, 1]])
 
 
+def _ring_position(ring: tuple[float, float], rng: np.random.Generator) -> np.ndarray:
+    radius = rng.uniform(*ring)
+    angle = rng.uniform(0.0, 2 * np.pi)
+    return radius * np.array([np.cos(angle), np.sin(angle)])
+
+
 def placements(
-    ring: tuple[float, float], n: int, rng: np.random.Generator, min_gap: float
+    ring: tuple[float, float],
+    n: int,
+    rng: np.random.Generator,
+    min_gap: float,
+    clear: Callable[[np.ndarray], bool] | None = None,
+    redraw: np.random.Generator | None = None,
 ) -> np.ndarray:
     """(n, 3, 2) toy positions, each toy uniform in the ring (area-uniform radius is not the
     study's rule: like the world's placements, the radius is uniform), toys at least
-    `min_gap` (m) apart: two solid toys cannot overlap."""
+    `min_gap` (m) apart: two solid toys cannot overlap. `clear`: where given, a toy it finds
+    not clear (of the stick: `scene_placements`) is drawn again from `redraw`, its own
+    generator, so that `rng` draws what it draws without `clear`: every scene that was clear
+    stays as it was, and so do the draws after it."""
     out = np.empty((n, 3, 2))
+
+    def apart(xy: np.ndarray, p: int, i: int) -> bool:
+        return all(np.linalg.norm(xy - out[p, j]) >= min_gap for j in range(i))
+
     for p in range(n):
         for i in range(3):
-            while True:
-                radius = rng.uniform(*ring)
-                angle = rng.uniform(0.0, 2 * np.pi)
-                xy = radius * np.array([np.cos(angle), np.sin(angle)])
-                if all(np.linalg.norm(xy - out[p, j]) >= min_gap for j in range(i)):
-                    break
+            while not apart(xy := _ring_position(ring, rng), p, i):
+                pass
+            if clear is not None and redraw is not None:
+                while not clear(xy):
+                    while not apart(xy := _ring_position(ring, redraw), p, i):
+                        pass
             out[p, i] = xy
     return out
+
+
+def scene_placements(
+    room: Playroom,
+    ring: tuple[float, float],
+    settings: EvaluationSettings,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """The toys of a ring's `settings.n_placements` test scenes (`placements`), clear of the
+    stick at its start pose where the settings say so (every test starts with it there): a toy
+    that is not is drawn again from a generator of its own (REDRAW_STREAM), so that every other
+    scene, caregiver and random reference command is the default evaluation's."""
+    if not settings.scenes_clear_of_stick:
+        return placements(ring, settings.n_placements, rng, room.min_toy_gap)
+    handle, tip = room.experimenter.start_stick()
+    clear = functools.partial(room.experimenter.clear_of_stick, handle=handle, tip=tip)
+    redraw = np.random.default_rng([settings.seed, REDRAW_STREAM, int(1000 * ring[0])])
+    return placements(ring, settings.n_placements, rng, room.min_toy_gap, clear, redraw)
 
 
 def movement_contacts(events: list[ev.Event], toy: str) -> tuple[str, str]:
@@ -110,7 +158,7 @@ def competence_of(
     # `with`: the bar's line is ended however the evaluation ends (Ctrl-C, a fault).
     with tqdm(total=total, disable=not progress, desc="evaluation", unit="test") as bar:
         for ring_index, ring in enumerate(room.config.toy_rings, start=1):
-            toys_of = placements(ring, settings.n_placements, rng, room.min_toy_gap)
+            toys_of = scene_placements(room, ring, settings, rng)
             caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
             for p in range(settings.n_placements):
                 room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])

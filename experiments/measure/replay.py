@@ -30,8 +30,13 @@ import numpy as np
 import pandas as pd
 
 from experiments import eval_record, manifest, storage
+from experiments.eval_record import SCENES_KEY
 from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
-from experiments.measure.evaluation import EvaluationSettings, goal_trajectory, placements
+from experiments.measure.evaluation import (
+    EvaluationSettings,
+    goal_trajectory,
+    scene_placements,
+)
 from experiments.run.trial_checks import load_trial
 from experiments.run.trial_files import TrialError
 from learner.agent import Agent
@@ -52,7 +57,7 @@ def replay_table(agent: Agent, room: Playroom, settings: EvaluationSettings) -> 
     rng = np.random.default_rng(settings.seed)
     stick_start = (*room.config.stick_start_handle, room.config.stick_start_angle)
     rows = []
-    toys_of = placements(room.config.toy_rings[0], settings.n_placements, rng, room.min_toy_gap)
+    toys_of = scene_placements(room, room.config.toy_rings[0], settings, rng)
     caregivers = rng.uniform(-1, 1, (settings.n_placements, 2))
     for p in range(settings.n_placements):
         room.arrange(stick=stick_start, toys=toys_of[p], caregiver=caregivers[p])
@@ -99,7 +104,11 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
             summary = eval_record.read_evaluation(trial_dir, config, remedy)
             # The evaluation's scenes (its placements), and the random command it played on
             # each of them beside the replays.
-            table = replay_table(agent, room, EvaluationSettings(int(summary["n_placements"])))
+            settings = EvaluationSettings(
+                int(summary["n_placements"]),
+                scenes_clear_of_stick=bool(summary.get(SCENES_KEY, False)),
+            )
+            table = replay_table(agent, room, settings)
             if table.empty:  # no arm test chosen by a model (an untrained agent)
                 continue
             data = manifest.read_evaluation_file(trial_dir, COMPETENCE_FILE, summary)

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from experiments import eval_record, manifest, provenance, storage
+from experiments.eval_record import SCENES_KEY
 from experiments.eval_worlds import OWN, EvalWorldError, own_world, world_record
 from experiments.file_names import (
     COMPETENCE_FILE,
@@ -158,6 +159,8 @@ def measured(
     summary = summarise_trial(config, competence, vocal)
     summary["evaluated_at_iteration"] = int(evaluated_at)
     summary["n_placements"] = settings.n_placements
+    if settings.scenes_clear_of_stick:
+        summary[SCENES_KEY] = True
     # The evaluation is computed too: its numbers carry the machine's bits as well.
     summary["evaluated_on"] = provenance.short_record(provenance.machine_record())
     # The study measured in the scene its tests start from (above), carried over from test to

@@ -4,26 +4,28 @@ batch directory, or one group of it where the batch holds both backends (the com
 kinematic and physical halves are the ladder's first and last rungs).
 
 For every headline measure (`HEADLINE`, entries of the registry experiments/report/measures.py)
-one value per trial, the agent the unit. Each step, from a rung to the next, is the mean over
-seeds of the later rung's value minus the earlier's, paired by seed, with its 95% interval and
-the paired t test's two-sided p; the whole difference is the last rung minus the first on the
-seeds both hold, and the steps' sum is set against it (the same seeds in every rung and no
-missing value make them equal; otherwise the page says by how much they differ). A rung beside
-the ladder (settling, after the physical backend) is set against the last rung.
+one value per trial, the agent the unit. Each step, from a rung to the next, is what the rule
+the later rung changes does given the rules before it, in this one order: the mean over seeds
+of the later rung's value minus the earlier's, paired by seed, with its 95% interval, the
+paired t test's two-sided p and the Wilcoxon signed-rank p (experiments/analysis/
+step_split.py). The whole difference is the last rung minus the first; a rung beside the
+ladder (settling, after the physical backend) is set against the last rung. Steps are taken on
+the seeds every rung holds; `completeness` says whether every rung holds every seed in its own
+world and in every test world, and what it lacks.
 
 Cross-evaluation, where the rungs' agents were also tested in the kinematic and physical
 worlds (`playroom eval DIR --world W`): each step of each competence measure splits, for a
-test world W, into what the agents learned (the later rung's agents against the earlier's,
-both tested in W) and what the rungs' own test worlds do ((B own - B in W) - (A own - A in W),
-per seed): the two add up to the step exactly, seed by seed.
+test world W, into both rungs' agents tested in W and the rungs' own worlds against W
+(step_split.py, which says what each computes).
 
-Holm's correction runs over every test of the page. The page itself: experiments/report/
-ladder_page.py; the waterfall figure: experiments/report/ladder_figure.py.
+The family of tests is declared here (`FAMILY`, `family`) from the rungs and the measures
+alone, before any value is read; Holm's correction runs over it, for each kind of p. The page
+itself: experiments/report/ladder_page.py; the per-trial data written beside it:
+experiments/report/ladder_data.py; the waterfall figure: experiments/report/ladder_figure.py.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from itertools import pairwise
 from pathlib import Path
@@ -31,12 +33,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments.analysis import eval_world_results
+from experiments.analysis import eval_world_results, step_split
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, collect
-from experiments.analysis.stats import paired_difference, regions
+from experiments.analysis.stats import regions
 from experiments.analysis.strategies import DEFINITIONS
-from experiments.analysis.trial_tests import holm, paired_arrays
 from experiments.analysis.trial_values import VALUE
 from experiments.report.measures import Measure, registry
 
@@ -44,6 +45,17 @@ OWN = "own"
 WORLDS = ("kinematic", "physical")
 STEP, WHOLE, WHOLE_ALL, BESIDE = "step", "whole", "whole_all", "beside"
 COMPETENCE = ("competence_all", "competence_ring1", "competence_ring2", "competence_ring3")
+# The page's one family of tests, fixed by the rungs and the measures before any value is read
+# (`family` lists it; the page prints this): Holm's correction runs over all of it.
+FAMILY = (
+    "every headline measure: each step, the whole (first rung to last) and each rung beside "
+    "the ladder against the last rung, on the seeds every rung holds, and the whole on every "
+    "seed of the first and last rungs where they hold more seeds than every rung does",
+    "every competence measure: each of those comparisons in each test world (kinematic, "
+    "physical), split in its two parts (both rungs' agents tested there; the rungs' own "
+    "worlds against it); a part whose rungs were not tested in that world is a test that "
+    "could not be made (no p, not counted in Holm's m)",
+)
 
 
 @dataclass(frozen=True)
@@ -143,98 +155,108 @@ def _series(values: pd.DataFrame, rung: str, key: str, tested: str = OWN) -> pd.
     return mine.set_index("seed")["value"]
 
 
-def _paired(b: pd.Series, a: pd.Series) -> dict[str, float]:
-    """B minus A over the seeds both hold (finite on both sides)."""
-    x, y = paired_arrays(b, a)
-    mean, low, high, p = paired_difference(x, y)
-    return {"mean": mean, "low": low, "high": high, "p": p, "n": len(x)}
-
-
 def common_seeds(values: pd.DataFrame, order: list[str]) -> set[int]:
     """The seeds every rung of the ladder holds."""
     return set.intersection(*(set(values.loc[values["rung"] == r, "seed"]) for r in order))
 
 
-def _steps(order: list[str], beside: list[str]) -> list[tuple[str, str, str]]:
+def _comparisons(order: list[str], beside: list[str]) -> list[tuple[str, str, str]]:
     """(kind, from, to) of every comparison the page makes: each step, the whole (first rung to
     last) and each rung beside the ladder against the last rung."""
     steps = [(STEP, a, b) for a, b in pairwise(order)]
     return [*steps, (WHOLE, order[0], order[-1]), *((BESIDE, order[-1], r) for r in beside)]
 
 
+FAMILY_COLUMNS = ["key", "kind", "from", "to", "world", "part"]
+
+
+def family(
+    order: list[str], beside: list[str], measures: list[Headline], ends_hold_more: bool
+) -> pd.DataFrame:
+    """Every test of the page (FAMILY), from the rungs and the measures alone: columns key,
+    kind, from, to, world (OWN for a step of the rungs' own worlds) and part ("step" or a
+    step_split part). `ends_hold_more`: the first and last rungs hold seeds some rung lacks."""
+    rows = []
+    comparisons = _comparisons(order, beside)
+    whole_all = [(WHOLE_ALL, order[0], order[-1])] if ends_hold_more else []
+    for h in measures:
+        for kind, a, b in [*comparisons[: len(order)], *whole_all, *comparisons[len(order) :]]:
+            rows.append({"key": h.key, "kind": kind, "from": a, "to": b, "world": OWN})
+            rows[-1]["part"] = STEP
+    for key in COMPETENCE:
+        for kind, a, b in comparisons:
+            for world in WORLDS:
+                for part in step_split.PARTS:
+                    rows.append({"key": key, "kind": kind, "from": a, "to": b, "world": world})
+                    rows[-1]["part"] = part
+    return pd.DataFrame(rows, columns=FAMILY_COLUMNS)
+
+
+def _ends_hold_more(values: pd.DataFrame, order: list[str]) -> bool:
+    ends = [set(values.loc[values["rung"] == r, "seed"]) for r in (order[0], order[-1])]
+    return len(ends[0] & ends[1]) > len(common_seeds(values, order))
+
+
 def step_tests(
     values: pd.DataFrame, order: list[str], beside: list[str], measures: list[Headline]
 ) -> pd.DataFrame:
-    """One row per (measure, step): each step of the ladder and the whole difference (first
-    rung to last), on the seeds every rung holds, so that the steps' sum is the whole wherever
-    no value is missing; the whole on every seed the first and last rungs hold (WHOLE_ALL),
-    where they hold more; and each rung beside the ladder against the last rung."""
-    common = common_seeds(values, order)
-    ladder = values[values["seed"].isin(common)]
-    pairs = [(kind, a, b, ladder) for kind, a, b in _steps(order, [])]
-    ends = [set(values.loc[values["rung"] == r, "seed"]) for r in (order[0], order[-1])]
-    if len(ends[0] & ends[1]) > len(common):
-        pairs.append((WHOLE_ALL, order[0], order[-1], values))
-    pairs += [(BESIDE, order[-1], r, values) for r in beside]
+    """One row per (measure, comparison) of the family in the rungs' own worlds: each step and
+    the whole on the seeds every rung holds; the whole on every seed the first and last rungs
+    hold (WHOLE_ALL), where they hold more; each rung beside against the last rung, on the
+    seeds both hold."""
+    ladder = values[values["seed"].isin(common_seeds(values, order))]
+    tested = family(order, beside, measures, _ends_hold_more(values, order))
     rows = []
-    for h in measures:
-        for kind, a, b, table in pairs:
-            tested = _paired(_series(table, b, h.key), _series(table, a, h.key))
-            rows.append({"key": h.key, "kind": kind, "from": a, "to": b, **tested})
+    for case in tested[tested["world"] == OWN].to_dict("records"):
+        table = ladder if case["kind"] in (STEP, WHOLE) else values
+        a, b = _series(table, case["from"], case["key"]), _series(table, case["to"], case["key"])
+        rows.append({k: case[k] for k in ("key", "kind", "from", "to")})
+        rows[-1].update(step_split.paired_test(b, a))
     return pd.DataFrame(rows)
 
 
 def split_tests(values: pd.DataFrame, order: list[str], beside: list[str]) -> pd.DataFrame:
-    """Each step (and the whole difference, and each rung beside) of each competence measure
-    split, in each test world both rungs' agents were tested in, into `learned` and `worlds`
-    (module docstring); steps whose rungs lack a test world are left out."""
-    values = values[values["seed"].isin(common_seeds(values, order)) | values["rung"].isin(beside)]
-    rows = []
-    for key in COMPETENCE:
-        for kind, a, b in _steps(order, beside):
-            for world in WORLDS:
-                a_in, b_in = _series(values, a, key, world), _series(values, b, key, world)
-                if a_in.empty or b_in.empty:
-                    continue
-                a_own, b_own = _series(values, a, key), _series(values, b, key)
-                worlds = (b_own - b_in) - (a_own - a_in)  # per seed, NaN where one lacks it
-                zero = pd.Series(0.0, index=worlds.index)
-                for part, tested in (
-                    ("learned", _paired(b_in, a_in)),
-                    ("worlds", _paired(worlds.dropna(), zero)),
-                ):
-                    rows.append(
-                        {"key": key, "kind": kind, "from": a, "to": b, "world": world}
-                        | {"part": part, **tested}
-                    )
+    """Each comparison of each competence measure split, in each test world, into its two parts
+    (step_split.split_step) on the seeds of the comparison it splits (`step_tests`); a part
+    whose rungs were not both tested in that world is in the table without a test (no
+    pairs)."""
+    ladder = values[values["seed"].isin(common_seeds(values, order))]
+    tested = family(order, beside, [], False)
+    rows: list[dict] = []
+    for case in tested.drop_duplicates(["key", "kind", "from", "to", "world"]).to_dict("records"):
+        a, b, key, world = case["from"], case["to"], case["key"], case["world"]
+        # The seeds of the step it splits (`step_tests`): a rung beside, all both hold.
+        table = ladder if case["kind"] in (STEP, WHOLE) else values
+        split = step_split.split_step(
+            _series(table, a, key),
+            _series(table, b, key),
+            _series(table, a, key, world),
+            _series(table, b, key, world),
+        )
+        for part, result in split.items():
+            rows.append({**case, "part": part} | result)
     return pd.DataFrame(rows)
 
 
-def with_holm(*tables: pd.DataFrame) -> tuple[pd.DataFrame, ...]:
-    """The tables with `p_holm`: Holm's adjustment over every p of all of them."""
-    ps = [float(p) for t in tables if len(t) for p in t["p"]]
-    adjusted = holm(ps)
-    out, start = [], 0
-    for table in tables:
-        table = table.copy()
-        table["p_holm"] = adjusted[start : start + len(table)] if len(table) else []
-        start += len(table)
-        out.append(table)
-    return tuple(out)
-
-
-def steps_sum(steps: pd.DataFrame) -> pd.DataFrame:
-    """Per measure: the whole difference, its interval, the steps' sum and the whole minus
-    that sum (0 where every rung holds the same seeds with every value)."""
+def completeness(values: pd.DataFrame, rungs: list[str]) -> pd.DataFrame:
+    """What the page checks before its steps mean what they say: one row per rung, the seeds it
+    holds in its own world, those of the ladder's seeds (every seed any rung holds) it lacks
+    there and in each test world, and how many of its values are not finite (a trial without
+    a value for a measure: catches per grasp without a grasp). `complete`: it lacks no seed in
+    any world."""
+    every = set(values.loc[values["tested"] == OWN, "seed"])
     rows = []
-    for key, mine in steps.groupby("key", sort=False):
-        whole = mine[mine["kind"] == WHOLE].iloc[0]
-        total = float(mine.loc[mine["kind"] == STEP, "mean"].sum(min_count=1))
-        within = bool(whole["low"] <= total <= whole["high"]) if math.isfinite(total) else False
-        rows.append(
-            {"key": key, "whole": whole["mean"], "low": whole["low"], "high": whole["high"]}
-            | {"steps_sum": total, "whole_minus_sum": whole["mean"] - total, "within": within}
-        )
+    for rung in rungs:
+        mine = values[values["rung"] == rung]
+        row: dict = {"rung": rung, "seeds": len(set(mine.loc[mine["tested"] == OWN, "seed"]))}
+        lacks = []
+        for world in (OWN, *WORLDS):
+            missing = sorted(every - set(mine.loc[mine["tested"] == world, "seed"]))
+            row[f"missing_{world}"] = missing
+            lacks += missing
+        row["not_finite"] = int((~np.isfinite(mine["value"])).sum())
+        row["complete"] = not lacks
+        rows.append(row)
     return pd.DataFrame(rows)
 
 
@@ -245,12 +267,24 @@ def levels(values: pd.DataFrame) -> pd.DataFrame:
     return grouped.agg(mean="mean", n="count").reset_index()
 
 
-def read_ladder(
-    rungs: list[Rung], beside: list[Rung] | None = None
-) -> tuple[pd.DataFrame, list[Headline], dict[str, BatchResults], list[str]]:
-    """(values, headline measures, each rung's own results, notes of cross-evaluations not
-    found) of the rungs in ladder order and those beside it. ReportError (one line) for a rung
+@dataclass(frozen=True)
+class LadderRead:
+    """What `read_ladder` found: every trial's values (VALUE_COLUMNS), the headline measures,
+    each rung's own results, who computed each trial in each world (ladder_data.provenance's
+    rows), and the cross-evaluations not found."""
+
+    values: pd.DataFrame
+    measures: list[Headline]
+    own: dict[str, BatchResults]
+    provenance: pd.DataFrame
+    missing: list[str]
+
+
+def read_ladder(rungs: list[Rung], beside: list[Rung] | None = None) -> LadderRead:
+    """The rungs in ladder order and those beside it, read. ReportError (one line) for a rung
     that cannot be read, fewer than two rungs, or two rungs of one name."""
+    from experiments.report.ladder_data import provenance
+
     every = [*rungs, *(beside or [])]
     if len(rungs) < 2:
         raise ReportError("a ladder needs at least two rungs (NAME=DIR[:GROUP] each)")
@@ -259,9 +293,10 @@ def read_ladder(
         raise ReportError(f"two rungs share a name: {', '.join(names)}")
     own = {r.name: rung_results(r) for r in every}
     measures = headline(Geometry.of(own[rungs[0].name]))
-    rows, missing = [], []
+    rows, missing, where = [], [], []
     for rung in every:
         rows += values_of(own[rung.name], rung.name, OWN, measures)
+        where.append(provenance(own[rung.name], rung.name, OWN))
         competence = [h for h in measures if h.key in COMPETENCE]
         for world in WORLDS:
             try:
@@ -270,4 +305,6 @@ def read_ladder(
                 missing.append(f"{rung.name} in the {world} world: {exc}")
                 continue
             rows += values_of(tested, rung.name, world, competence)
-    return pd.DataFrame(rows, columns=VALUE_COLUMNS), measures, own, missing
+            where.append(provenance(tested, rung.name, world))
+    values = pd.DataFrame(rows, columns=VALUE_COLUMNS)
+    return LadderRead(values, measures, own, pd.concat(where, ignore_index=True), missing)

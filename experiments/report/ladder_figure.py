@@ -1,8 +1,9 @@
 """The contact ladder's waterfall: one panel per headline measure. The first bar is the first
-rung's mean over its trials; each step floats from where the steps before it ended, its height
-the step's mean paired difference, its whisker the step's 95% interval; the last bar is the last
-rung's own mean (where it and the steps' end differ, the rungs' seeds or missing values differ).
-A rung beside the ladder floats, hatched, from the last rung. Shares in percent."""
+rung's mean over its trials; each step (its rule given the rules before it, in this order)
+floats from where the steps before it ended, its height the step's mean paired difference, its
+whisker the step's 95% interval; the last bar is the last rung's own mean (where it and the
+steps' end differ, the rungs' seeds or missing values differ). A rung beside the ladder floats,
+hatched, from the last rung. Shares in percent."""
 
 from __future__ import annotations
 
@@ -67,8 +68,8 @@ def waterfall(
     for ax in axes[len(measures) :]:
         ax.set_visible(False)
     fig.suptitle(
-        "Contact ladder: each rung's step, paired by seed (green up, red down, whisker 95% "
-        "interval); grey: the first and last rungs' means; shares in %",
+        "Contact ladder: each rung's step given the rules before it, paired by seed (green up, "
+        "red down, whisker 95% interval); grey: the first and last rungs' means; shares in %",
         fontsize=9,
     )
     return fig

@@ -1,7 +1,10 @@
 """The contact ladder's page (`playroom ladder NAME=DIR[:GROUP] ... --out DIR`): the tests of
 experiments/report/ladder.py written as one unit into DIR: ladder.md (the tables), ladder.csv
-(every test, unrounded), ladder.json (every trial's values, every test, the rungs and where
-they were computed) and ladder.png (the waterfall, experiments/report/ladder_figure.py)."""
+(every test of the family, unrounded, both kinds of p and their Holm adjustments),
+ladder-trials.csv (every trial's values in every world it was tested in, with the machine and
+commit that computed it: experiments/report/ladder_data.py), ladder.json (every trial's values,
+every test, the family, the completeness check, the rungs) and ladder.png (the waterfall,
+experiments/report/ladder_figure.py)."""
 
 from __future__ import annotations
 
@@ -13,25 +16,20 @@ from pathlib import Path
 import pandas as pd
 
 from experiments import provenance, storage
+from experiments.analysis import step_split
 from experiments.analysis.results import BatchResults, check_out_dir
-from experiments.analysis.trial_tests import survives
-from experiments.eval_worlds import READ_BY
-from experiments.report import ladder
-from experiments.report.ablations import describe_change
+from experiments.analysis.trial_tests import ALPHA, survives
+from experiments.report import ladder, ladder_data, rung_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
 from experiments.report.pages import machines_text, p_value, seeds_text
 
-FILES = ("ladder.csv", "ladder.json", "ladder.png", "ladder.md")
+FILES = ("ladder.csv", ladder_data.FILE, "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}
 WORLDS_TABLE_TITLE = (
     "Every rung's agents in each world (normalised competence, mean over the trials of the "
     "seeds every rung holds, trials in brackets):"
 )
-PART_TEXT = {
-    "learned": "learned (both rungs' agents tested in the {world} world)",
-    "worlds": "the test worlds (own against the {world} world, B's change minus A's)",
-}
 
 
 def signed_text(kind: str, x: float) -> str:
@@ -50,17 +48,24 @@ def level_text(kind: str, x: float) -> str:
     return signed_text(kind, x).lstrip("+")
 
 
-def _cell(kind: str, row: dict) -> str:
-    """A difference as "+1.5 [-0.0, +3.0], p = 0.054 (32)", * where it survives Holm."""
+def _p_text(p: float, adjusted: float) -> str:
+    return p_value(p) + (" *" if survives(adjusted) else "")
+
+
+def cell_text(kind: str, row: dict) -> str:
+    """A difference as "+1.5 [-0.0, +3.0], p = 0.054; rank p = 0.061 (32)": the paired t's p,
+    then the signed-rank test's, each * where it survives Holm over the page's family."""
     n = int(row["n"])
     if not math.isfinite(row["mean"]):
         return f"n/a ({n} pairs)"
     low, high = signed_text(kind, row["low"]), signed_text(kind, row["high"])
     text = f"{signed_text(kind, row['mean'])} [{low}, {high}]"
     if not math.isfinite(row["p"]):
-        return f"{text}, untested: every pair equal ({n})"
-    mark = " *" if survives(row["p_holm"]) else ""
-    return f"{text}, {p_value(row['p'])}{mark} ({n})"
+        why = "fewer than 2 pairs" if n < 2 else "every pair equal"
+        return f"{text}, untested: {why} ({n})"
+    t = _p_text(row["p"], row["p_holm"])
+    rank = _p_text(row["p_rank"], row["p_rank_holm"]).replace("p ", "rank p ", 1)
+    return f"{text}, {t}; {rank} ({n})"
 
 
 def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[dict]:
@@ -71,36 +76,33 @@ def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[d
     return [dict(r) for r in table[mask].to_dict("records")]
 
 
-def _change(before: dict, config: dict) -> str:
-    """What a rung changes from the one before, each world setting that its backend does not
-    read said so: another backend's switch (experiments/eval_worlds.py READ_BY)."""
-    grasp = config["trial"]["grasp"]
-    others = {name for g, names in READ_BY.items() if g != grasp for name in names}
-    unread = others - set(READ_BY.get(grasp, ()))
-    parts = []
-    for part in describe_change(before, config).split("; "):
-        key = part.split(":", 1)[0]
-        name = key.removeprefix("world.")
-        inert = key.startswith("world.") and name in unread
-        parts.append(f"{part} (not read by the {grasp} backend)" if inert else part)
-    return "; ".join(parts)
-
-
-def rungs_table(rungs: list[ladder.Rung], own: dict[str, BatchResults]) -> list[str]:
-    lines = ["| rung | batch | changes from the rung before | trials (seeds) | computed on |"]
-    lines.append("|---|---|---|---|---|")
+def rungs_table(
+    rungs: list[ladder.Rung], beside: list[ladder.Rung], own: dict[str, BatchResults]
+) -> list[str]:
+    """One row per rung: its batch, everything it changes from the rung before (a rung beside
+    the ladder: from the last rung) (rung_change.describe), its trials and where they were
+    computed."""
+    head = "| rung | batch | changes from the rung before | trials (seeds) | computed on |"
+    lines = [head, "|---|---|---|---|---|"]
     before = None
-    for rung in rungs:
+    last = None
+    for rung in [*rungs, *beside]:
+        if rung in beside:
+            before = last
         results = own[rung.name]
         group = results.groups[0]
-        config = results.configs[group]
-        change = "(the first rung)" if before is None else _change(before, config)
+        world = rung_change.RungWorld(
+            results.configs[group], rung_change.recorded_backend(results.trials)
+        )
+        change = "(the first rung)" if before is None else rung_change.describe(before, world)
         seeds = sorted(int(s) for s in results.trials["seed"])
         lines.append(
             f"| {rung.name} | {rung.batch_dir.name} ({group}) | {change} | "
             f"{len(seeds)} ({seeds_text(seeds)}) | {machines_text(results)} |"
         )
-        before = config
+        before = world
+        if rung == rungs[-1]:
+            last = world
     return lines
 
 
@@ -112,29 +114,22 @@ def steps_table(
     beside: list[str],
 ) -> list[str]:
     """Rows: measures; columns: the first rung's mean, each step, the last rung's mean, the
-    whole difference, the steps' sum, the whole on every seed and each rung beside."""
+    whole difference, the whole on every seed and each rung beside."""
     head = [f"{order[0]} (mean)", *(f"{a} -> {b}" for a, b in pairwise(order))]
-    head += [f"{order[-1]} (mean)", "whole (first to last)", "steps' sum (whole minus sum)"]
+    head += [f"{order[-1]} (mean)", "whole (first to last)"]
     if (steps["kind"] == ladder.WHOLE_ALL).any():
         head.append("whole, every seed of the first and last rungs")
     head += [f"{order[-1]} -> {r} (beside)" for r in beside]
     lines = ["| measure | " + " | ".join(head) + " |", "|---" * (len(head) + 1) + "|"]
-    sums = {r["key"]: r for r in _rows(ladder.steps_sum(steps))}
     for h in measures:
         kind = h.measure.kind
         level = {r["rung"]: r["mean"] for r in _rows(levels, tested=ladder.OWN, key=h.key)}
         cells = [level_text(kind, level.get(order[0], math.nan))]
-        cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.STEP)]
+        cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=ladder.STEP)]
         cells.append(level_text(kind, level.get(order[-1], math.nan)))
-        cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=ladder.WHOLE)]
-        s = sums[h.key]
-        inside = "within" if s["within"] else "outside"
-        cells.append(
-            f"{signed_text(kind, s['steps_sum'])} "
-            f"({signed_text(kind, s['whole_minus_sum'])}; {inside} the whole's interval)"
-        )
+        cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=ladder.WHOLE)]
         for which in (ladder.WHOLE_ALL, ladder.BESIDE):
-            cells += [_cell(kind, r) for r in _rows(steps, key=h.key, kind=which)]
+            cells += [cell_text(kind, r) for r in _rows(steps, key=h.key, kind=which)]
         lines.append(f"| {h.label} | " + " | ".join(cells) + " |")
     return lines
 
@@ -144,16 +139,24 @@ def split_table(splits: pd.DataFrame, levels: pd.DataFrame) -> list[str]:
     if splits.empty:
         return ["No rung was tested in another world (`playroom eval DIR --world W`)."]
     keys = list(ladder.COMPETENCE)
-    lines = ["| step | part | " + " | ".join(HEAD[k] for k in keys) + " |"]
+    lines = [
+        "Each step from A to B (A the earlier rung) in two parts that add up to it, seed by "
+        "seed: both rungs' agents tested in one world, and the rungs' own worlds against it. "
+        "For two rungs neither of whose own worlds is the test world, the second part contrasts "
+        "three worlds and is not what either rung's own world does alone "
+        "(experiments/analysis/step_split.py).",
+        "",
+    ]
+    lines += ["| step | part | " + " | ".join(HEAD[k] for k in keys) + " |"]
     lines.append("|---" * (len(keys) + 2) + "|")
     seen = splits[["from", "to", "kind", "world", "part"]].drop_duplicates()
     for case in seen.to_dict("records"):
         by_key = {r["key"]: r for r in _rows(splits, case)}
-        cells = [_cell("share", by_key[k]) if k in by_key else "" for k in keys]
+        cells = [cell_text("share", by_key[k]) if k in by_key else "" for k in keys]
         step = f"{case['from']} -> {case['to']}" + (
             " (whole)" if case["kind"] == ladder.WHOLE else ""
         )
-        part = PART_TEXT[case["part"]].format(world=case["world"])
+        part = step_split.PART_TEXT[case["part"]].format(world=case["world"])
         lines.append(f"| {step} | {part} | " + " | ".join(cells) + " |")
     lines += ["", WORLDS_TABLE_TITLE]
     lines += ["", "| rung | tested in | " + " | ".join(HEAD[k] for k in keys) + " |"]
@@ -167,36 +170,115 @@ def split_table(splits: pd.DataFrame, levels: pd.DataFrame) -> list[str]:
     return lines
 
 
-def markdown(command: str, rungs, beside, own, measures, steps, splits, levels, missing) -> str:
+def family_lines(steps: pd.DataFrame, splits: pd.DataFrame) -> list[str]:
+    """The family, as declared (ladder.FAMILY), with its counts."""
+    n = step_split.counts([steps, splits])
+    lines = [f"One family of {n['family']} tests, fixed by the rungs and the measures before any "]
+    lines[0] += "value was read (`experiments/report/ladder.py` FAMILY):"
+    lines += ["", *(f"- {part}" for part in ladder.FAMILY), ""]
+    lines.append(
+        f"{n['made']} of them could be made (a comparison whose every pair is equal, or whose "
+        f"rungs were not tested in a world, has no p and does not count in Holm's m). Holm's "
+        f"correction at {ALPHA} over them: {n['t']} survive with the paired t, {n['rank']} with "
+        "the Wilcoxon signed-rank test."
+    )
+    return lines
+
+
+def disagreement_lines(measures: list[ladder.Headline], tests: pd.DataFrame) -> list[str]:
+    """Every cell whose Holm star differs between the paired t and the signed-rank test."""
+    label = {h.key: h.label for h in measures} | {k: HEAD[k] for k in ladder.COMPETENCE}
+    differ = [r for r in tests.to_dict("records") if step_split.stars_differ(r)]
+    if not differ:
+        return ["None: every star of the page is the same under both tests."]
+    lines = []
+    for r in differ:
+        part = step_split.PART_SHORT.get(r["part"], "")
+        where = "" if r["part"] == ladder.STEP else ", " + part.format(world=r["world"])
+        starred = "the t" if survives(float(r["p_holm"])) else "the signed-rank test"
+        lines.append(
+            f"- {label.get(r['key'], r['key'])}, {r['from']} -> {r['to']} ({r['kind']}{where}): "
+            f"starred by {starred} only ({p_value(float(r['p']))}; rank "
+            f"{p_value(float(r['p_rank']))})"
+        )
+    return lines
+
+
+def _seeds_or_none(seeds: list[int]) -> str:
+    return seeds_text(seeds) if seeds else "none"
+
+
+def completeness_lines(check: pd.DataFrame) -> list[str]:
+    """The completeness check (ladder.completeness) and its verdict."""
+    worlds = [ladder.OWN, *ladder.WORLDS]
+    head = ["rung", "seeds", *(f"seeds lacking ({w})" for w in worlds), "values not finite"]
+    lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
+    for r in check.to_dict("records"):
+        missing = [_seeds_or_none(r[f"missing_{w}"]) for w in worlds]
+        lines.append(
+            f"| {r['rung']} | {r['seeds']} | " + " | ".join(missing) + f" | {r['not_finite']} |"
+        )
+    verdict = (
+        "Complete: every rung holds every seed in its own world and in both test worlds."
+        if check["complete"].all()
+        else "Incomplete: the steps are taken on the seeds every rung holds; the rows above "
+        "say what each rung lacks."
+    )
+    return [
+        "What it checks: that every rung (and every rung beside the ladder) holds every seed "
+        "any rung holds, in its own world and in each test world; a value that is not finite "
+        "(a trial with no value for a measure, such as catches per grasp without a grasp) is "
+        "counted, and its pairs are left out of that measure's tests.",
+        "",
+        *lines,
+        "",
+        verdict,
+    ]
+
+
+def markdown(
+    command: str, rungs, beside, read: ladder.LadderRead, steps, splits, levels, check
+) -> str:
     order, others = [r.name for r in rungs], [r.name for r in beside]
-    tests = pd.concat([steps, splits], ignore_index=True)
-    made = int(tests["p"].notna().sum())
-    kept = sum(survives(float(p)) for p in tests["p_holm"])
+    tests = pd.concat([steps.assign(part=ladder.STEP, world=ladder.OWN), splits], ignore_index=True)
     here = provenance.describe(provenance.short_record(provenance.machine_record()))
     lines = [
         "# The contact ladder",
         "",
         f"Written by `{command}`; statistics computed on {here}.",
         "",
-        f"{made} tests over trials (paired t over seeds, two-sided); {kept} survive Holm's "
-        "correction over all of them at 0.05 (marked *). No test here pools tests or words "
-        "across agents. Each cell: the mean over seeds of the later rung minus the earlier "
-        "[95% interval], p, (pairs). Shares in percentage points.",
+        f"Every trial's values, in every world it was tested in, with the machine and commit "
+        f"that computed it: [{ladder_data.FILE}]({ladder_data.FILE}), from which every number "
+        "here can be computed again.",
         "",
-        *rungs_table([*rungs, *beside], own),
+        "Tests over trials, the agent the unit, paired by seed: each cell is the mean over seeds "
+        "of the later rung minus the earlier [95% t interval], the paired t's two-sided p, the "
+        "Wilcoxon signed-rank test's two-sided p (rank p), (pairs); * after a p where it "
+        "survives Holm's correction over the page's one family (below), for its kind of p. No "
+        "test here pools tests or words across agents. Shares in percentage points.",
         "",
-        "## Each rung's step",
+        *rungs_table(rungs, beside, read.own),
         "",
-        *steps_table(measures, steps, levels, order, others),
+        "## Each rung's step, given the rules before it",
+        "",
+        "A step measures what the rule its rung changes does given the rules before it, in "
+        "this one order: another order, or a rule that acts with another, can give the same "
+        "rule another share of the whole.",
+        "",
+        *steps_table(read.measures, steps, levels, order, others),
         "",
         "![waterfall](ladder.png)",
         "",
-        "## Learned, or the test world? (cross-evaluation)",
+        "## Both tested in one world, or their own worlds against it? (cross-evaluation)",
         "",
         *split_table(splits, levels),
     ]
-    if missing:
-        lines += ["", "Not tested in another world:", "", *(f"- {m}" for m in missing)]
+    if read.missing:
+        lines += ["", "Not tested in another world:", "", *(f"- {m}" for m in read.missing)]
+    lines += ["", "## The family of tests", "", *family_lines(steps, splits)]
+    lines += ["", "## Where the t and the signed-rank test disagree on a star", ""]
+    lines += disagreement_lines(read.measures, tests)
+    lines += ["", "## Completeness", "", *completeness_lines(check)]
     return "\n".join(lines) + "\n"
 
 
@@ -218,32 +300,47 @@ def write_ladder(
     computed. Returns the page's path."""
     out = Path(out_dir)
     check_out_dir(out)
-    values, measures, own, missing = ladder.read_ladder(rungs, beside)
+    read = ladder.read_ladder(rungs, beside)
+    return storage.write_files(out, ladder_files(read, rungs, beside, command))[-1]
+
+
+def ladder_files(
+    read: ladder.LadderRead, rungs: list[ladder.Rung], beside: list[ladder.Rung], command: str
+) -> dict[str, bytes]:
+    """Every file of the page (FILES, the page last) from what `ladder.read_ladder` read."""
+    values, measures = read.values, read.measures
     order, others = [r.name for r in rungs], [r.name for r in beside]
     steps = ladder.step_tests(values, order, others, measures)
     splits = ladder.split_tests(values, order, others)
-    steps, splits = ladder.with_holm(steps, splits)
+    steps, splits = step_split.with_holm(steps, splits)
     # The rungs' means on the seeds the steps pair, so that the first plus the steps is the last.
     common = ladder.common_seeds(values, order)
     levels = ladder.levels(values[values["seed"].isin(common) | values["rung"].isin(others)])
-    page = markdown(command, rungs, beside, own, measures, steps, splits, levels, missing)
+    check = ladder.completeness(values, [*order, *others])
+    page = markdown(command, rungs, beside, read, steps, splits, levels, check)
+    rung_record = [
+        {"name": r.name, "batch": str(r.batch_dir), "group": r.group, "beside": r in beside}
+        for r in [*rungs, *beside]
+    ]
     record = {
         "command": command,
-        "rungs": [{"name": r.name, "batch": str(r.batch_dir), "group": r.group} for r in rungs],
-        "beside": [{"name": r.name, "batch": str(r.batch_dir), "group": r.group} for r in beside],
+        "rungs": rung_record,
         "measures": {h.key: {"label": h.label, "kind": h.measure.kind} for h in measures},
+        "family": list(ladder.FAMILY),
         "values": json_records(values),
         "steps": json_records(steps),
         "splits": json_records(splits),
-        "steps_sum": json_records(ladder.steps_sum(steps)),
+        "completeness": json_records(check),
         "levels": json_records(levels),
-        "not_tested": missing,
+        "not_tested": read.missing,
     }
-    tests = pd.concat([steps.assign(part="step"), splits], ignore_index=True)
-    files = {
+    tests = pd.concat([steps.assign(part=ladder.STEP, world=ladder.OWN), splits], ignore_index=True)
+    keys = [h.key for h in measures]
+    trials = ladder_data.trial_table(values, read.provenance, keys)
+    return {
         "ladder.csv": tests.to_csv(index=False).encode(),
+        ladder_data.FILE: trials.to_csv(index=False).encode(),
         "ladder.json": storage.json_bytes(record),
         "ladder.png": png_bytes(waterfall(measures, steps, levels, order)),
         "ladder.md": page.encode(),
     }
-    return storage.write_files(out, files)[-1]

@@ -52,6 +52,12 @@ class GraspBackend(abc.ABC):
     carrying_class: Callable[[ModelEdits], Carrying] = PlacedCarrying
     rule_class: Callable[[WorldConfig, ModelEdits, str], Any] | None = None
 
+    @classmethod
+    def carrying_for(cls, config: WorldConfig) -> Callable[[ModelEdits], Carrying]:
+        """The caregiver's carrying in a world of `config`: `carrying_class`, unless a world
+        setting the backend reads chooses another."""
+        return cls.carrying_class
+
     def __init__(
         self, config: WorldConfig, edits: ModelEdits, carrying: Carrying, rule: Any = None
     ) -> None:
@@ -107,8 +113,9 @@ class GraspBackend(abc.ABC):
     def capabilities(self) -> dict[str, bool]:
         """What a reader of this backend's trials may need to know: `solid` (see above),
         `pushes` (an unheld object moves when something touches it: solid, unless the world
-        switches pushing off), `closed_form` (see above)."""
-        pushes = self.solid and self.config.push_objects
+        switches pushing off or its touches to sensed only), `closed_form` (see above)."""
+        held_still = not self.config.push_objects or self.config.unheld_contacts == "sensed"
+        pushes = self.solid and not held_still
         return {"solid": self.solid, "pushes": pushes, "closed_form": self.closed_form}
 
 

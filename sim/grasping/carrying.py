@@ -7,6 +7,13 @@ at each step is her path, `brought_path`, which each backend's `simulate` follow
 - `WeldedCarrying` (the physical backend's): her hand, a mocap body, goes to the toy and a weld
   holds it there; she lifts it (it touches nothing while carried, as a toy carried above the
   table would not); putting it down undoes that and brings her hand back beside her.
+- `LiftedPlacedCarrying` (the physical backend's under `WorldConfig.caregiver_carrying`
+  "placed", a part of the contact step unbundled): the toy itself put at each step of her path,
+  as the kinematic rules place it, lifted and touching nothing while carried as the welded toy
+  is: only the weld's dynamics differ.
+
+Each says what her path moves (`moves`): the two numbers each control step of a physical
+movement sets to the path's next point (sim/physics.py `control_steps`).
 """
 
 from __future__ import annotations
@@ -37,6 +44,19 @@ class Carrying(Protocol):
         """She puts the toy down where it is."""
         ...
 
+    def moves(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """What her path moves while she brings toy `toy`: a view of the data whose first two
+        numbers are its x, y."""
+        ...
+
+
+def _toy_xy(physics: PlayroomPhysics, toy: int) -> np.ndarray:
+    """A view of the data's qpos holding toy `toy`'s x, y (its slide joints, consecutive)."""
+    x, y, _ = physics.object_qpos[1 + toy]
+    if y != x + 1:
+        raise ValueError("the MJCF model's toy joints are not x, y, yaw in this order")
+    return physics.data.ptr.qpos[x : x + 2]
+
 
 class PlacedCarrying:
     """The toy itself is placed at every step of her path, as in the study."""
@@ -50,6 +70,10 @@ class PlacedCarrying:
 
     def puts_down(self, physics: PlayroomPhysics) -> None:
         """Nothing to undo: the toy lies where it was last placed."""
+
+    def moves(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """The toy itself."""
+        return _toy_xy(physics, toy)
 
 
 class WeldedCarrying:
@@ -77,3 +101,29 @@ class WeldedCarrying:
         d = physics.data.ptr
         physics.stop_objects()
         d.mocap_pos[physics.caregiver_hand_mocap, :2] = physics.caregiver_position()
+
+    def moves(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """Her hand (its mocap position), which the weld follows."""
+        return physics.data.ptr.mocap_pos[physics.caregiver_hand_mocap]
+
+
+class LiftedPlacedCarrying:
+    """The toy placed at every step of her path, lifted off the table, touching nothing."""
+
+    def __init__(self, edits: ModelEdits) -> None:
+        self.edits = edits
+
+    def takes(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """She lifts the toy where it lies (as the welded carrying does, without her hand):
+        her path starts there."""
+        self.edits.make_intangible(CAREGIVER, physics.toy_geoms[toy])
+        self.edits.lift(CAREGIVER, OBJECTS.index(TOYS[toy]))
+        return physics.toy_positions()[toy].copy()
+
+    def puts_down(self, physics: PlayroomPhysics) -> None:
+        self.edits.clear(CAREGIVER)
+        physics.stop_objects()
+
+    def moves(self, physics: PlayroomPhysics, toy: int) -> np.ndarray:
+        """The toy itself (its joints' x, y), still between steps: nothing touches it."""
+        return _toy_xy(physics, toy)

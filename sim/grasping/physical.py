@@ -4,10 +4,13 @@ whatever touches it; a movement's control steps run compiled (sim/compiled_steps
 here when a contact its grasp rule acts on appears. Its parts, which the playroom
 builds and hands it: the grasp rule (sim/grasping/contact_rule.py: what a touch takes, held by
 welds) and the caregiver's carrying (sim/grasping/carrying.py: her hand welded to the toy,
-lifted above the table).
+lifted above the table; or, under `WorldConfig.caregiver_carrying` "placed", the lifted toy
+put on her path).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -16,7 +19,7 @@ from sim import events as ev
 from sim.compiled_steps import AVAILABLE, MISSING
 from sim.config import SETTLE_PHYSICS_STEPS, WorldConfig
 from sim.grasping.base import GraspBackend, arm_to_rest
-from sim.grasping.carrying import Carrying, WeldedCarrying
+from sim.grasping.carrying import Carrying, LiftedPlacedCarrying, WeldedCarrying
 from sim.grasping.contact_rule import WATCHED_BY_NOTHING, ContactRule
 from sim.kinematics import segment_distance
 from sim.model_edits import ModelEdits
@@ -34,6 +37,12 @@ class PhysicalGrasp(GraspBackend):
     physics_class = PlayroomPhysics
     carrying_class = WeldedCarrying
     rule_class = ContactRule
+
+    @classmethod
+    def carrying_for(cls, config: WorldConfig) -> Callable[[ModelEdits], Carrying]:
+        """Welded, or the toy placed on her path (`WorldConfig.caregiver_carrying`)."""
+        return LiftedPlacedCarrying if config.caregiver_carrying == "placed" else WeldedCarrying
+
     solid = True
     closed_form = False
     rule: ContactRule
@@ -64,13 +73,15 @@ class PhysicalGrasp(GraspBackend):
         grasping = movement.space == ARM
         # The servos' targets; a vocal movement leaves them at rest.
         targets = np.ascontiguousarray(movement.controls) if grasping else _NO_TARGETS
-        path = None if movement.brought is None else movement.brought.path
+        brought = movement.brought
+        path = None if brought is None else brought.path
+        moved = None if brought is None else self.carrying.moves(physics, brought.toy)
         warnings = physics.warning_counts()
         events: list[ev.Event] = []
 
         def steps_from(k: int) -> int:
             watched = self.watched_contacts() if grasping else WATCHED_BY_NOTHING
-            return physics.control_steps(k, targets, path, positions, watched, trace)
+            return physics.control_steps(k, targets, path, positions, watched, trace, moved)
 
         k = steps_from(0)
         while k < N_STEPS:  # a contact the grasp acts on, after step k

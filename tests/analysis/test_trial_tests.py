@@ -94,3 +94,14 @@ def test_a_p_that_underflows_prints_as_a_bound():
     test = difference_test(_by_seed(d), _by_seed(np.zeros(64)), paired=True)
     assert test.p == 0.0
     assert p_value(test.p) == "p < 1e-300"
+
+
+def test_the_signed_rank_p_is_exact_on_few_pairs_and_none_where_every_pair_is_equal():
+    from experiments.analysis.trial_tests import signed_rank_p
+
+    # 8 differences of one sign, no ties: the exact two-sided p is 2 / 2^8.
+    assert signed_rank_p(np.arange(1.0, 9.0)) == pytest.approx(2 / 2**8)
+    assert np.isnan(signed_rank_p(np.zeros(8))) and np.isnan(signed_rank_p(np.full(8, 0.3)))
+    assert np.isnan(signed_rank_p(np.array([1.0])))
+    # Ties (a measure of few values): the normal approximation, a p all the same.
+    assert 0 < signed_rank_p(np.array([0.0, 0.0, 1, 1, 1, 2, 2, -1] * 4)) < 0.05

@@ -192,13 +192,43 @@ def test_a_backend_moves_alike_whatever_the_switches_it_is_not_listed_with(grasp
     commands = np.random.default_rng(7).uniform(-1, 1, (25, ARM_DIM))
     base = world_preset("study")
     flipped = {
+        "catch_distance": 0.055,
         "catch_rule": "held_stick",
+        "arm_dynamics": "servo",
+        "placements_clear": True,
+        "stick_return_reach": None,
         "push_objects": False,
         "settle_between_movements": True,
+        "held_pose": "aligned",
+        "unheld_contacts": "sensed",
+        "caregiver_carrying": "placed",
     }
+    assert set(flipped) == set(SWITCHES)
     unread = {s: v for s, v in flipped.items() if s not in READ_BY[grasp]}
+    voice = np.random.default_rng(8).uniform(-1, 1, (25, 28))
     outcomes = []
     for world in (base, dataclasses.replace(base, **unread)):
         room = Playroom(grasp, seed=5, config=world)
-        outcomes.append([room.act("arm", m).s for m in commands])
+        outcomes.append(
+            [
+                room.act(s, m).s
+                for a, v in zip(commands, voice, strict=True)
+                for s, m in (("arm", a), ("voice", v))
+            ]
+        )
     assert np.array_equal(np.array(outcomes[0]), np.array(outcomes[1]))
+
+
+def test_the_protocol_names_every_switch_an_eval_world_resets():
+    """docs/protocol.md D26 lists the switches an eval world sets to the trial preset's
+    values: every one of them (it once left out arm_dynamics and held_pose)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "protocol.md").read_text()
+    d26 = text.split("**D26.")[1].split("**D27.")[0]
+    config = full_config(TrialSettings(grasp="kinematic", iterations=10, seed=0))
+    _, world = eval_worlds.world_settings(config, "physical")
+    preset = world_preset("study")
+    for switch in eval_worlds.SWITCHES:
+        assert f"`{switch}`" in d26, switch
+        assert world[switch] == getattr(preset, switch)
