@@ -14,11 +14,12 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from experiments.baseline.control_settings import CONTROL, DEFAULTS, ControlError
-from experiments.batches.spec import BatchError, load_spec
-from experiments.run.settings import TrialSettings
-from sim.config import WorldConfig
+
+if TYPE_CHECKING:  # the command line's help reads this module: it loads no batch or world
+    from experiments.run.settings import TrialSettings
 
 RACE_CONFIG = Path("experiments") / "batches" / "rl-baseline" / "comparison.json"
 MODEL_BABBLING = "model-babbling"
@@ -112,6 +113,9 @@ def race_runs(
     """Each learner's run for every trial of a batch config (the first `seeds` of its seeds,
     `iterations` for its own, `grasps` of its grasps where given: a smaller race of the same
     form); RaceError (one line) for a config the toys' goal environment cannot match."""
+    from experiments.batches.spec import BatchError, load_spec
+    from sim.config import WorldConfig
+
     try:
         spec = load_spec(config_file=config_file)
     except BatchError as exc:
