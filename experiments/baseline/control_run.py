@@ -184,30 +184,43 @@ def run_control(
         lock.release()
 
 
-def _started(out: Path, first: ControlSettings) -> dict:
-    """control.json: written for a new directory, or read back."""
-    path = out / CONTROL_FILE
+def opened_record(
+    out: Path, name: str, what: str, error: type[Exception], new: Callable[[], dict]
+) -> dict:
+    """The record `name` of a run directory (`what` it holds) read back, or `new()` written
+    into a new one; `error` (one line) for a damaged record or a directory holding another
+    thing. Shared by the control and the race."""
+    path = out / name
     if path.exists():
         try:
             record = storage.read_json(path)
             record["settings"]  # noqa: B018  (a record without it is damaged)
         except (storage.CorruptFileError, KeyError, TypeError):
-            raise ControlError(f"{path} is damaged: remove {out} to run it again") from None
+            raise error(f"{path} is damaged: remove {out} to run it again") from None
         return record
     if out.exists() and any(p.name != ".lock" for p in out.iterdir()):
-        raise ControlError(f"{out} is not empty and holds no control: give another --out")
-    defaults = library_defaults()
-    record = {
-        "settings": {k: first.record()[k] for k in SHARED},
-        "test_goals": {
-            "first_reset_seed": FIRST_TEST_SEED[first.test_goals],
-            "random_commands_per_goal": RANDOM_COMMANDS_PER_GOAL,
-        },
-        "learner": learner_values() if first.settings == CONTROL else defaults,
-        "stable_baselines3_defaults": defaults,
-    }
+        raise error(f"{out} is not empty and holds no {what}: give another --out")
+    record = new()
     storage.write_json(path, record)
     return record
+
+
+def _started(out: Path, first: ControlSettings) -> dict:
+    """control.json: written for a new directory, or read back."""
+
+    def new() -> dict:
+        defaults = library_defaults()
+        return {
+            "settings": {k: first.record()[k] for k in SHARED},
+            "test_goals": {
+                "first_reset_seed": FIRST_TEST_SEED[first.test_goals],
+                "random_commands_per_goal": RANDOM_COMMANDS_PER_GOAL,
+            },
+            "learner": learner_values() if first.settings == CONTROL else defaults,
+            "stable_baselines3_defaults": defaults,
+        }
+
+    return opened_record(out, CONTROL_FILE, "control", ControlError, new)
 
 
 def _written(

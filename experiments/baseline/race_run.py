@@ -33,6 +33,7 @@ import pandas as pd
 from experiments import provenance, storage
 from experiments.baseline import control_learner as cl
 from experiments.baseline import race_learners as rl
+from experiments.baseline.control_run import opened_record
 from experiments.baseline.control_settings import (
     RANDOM_COMMANDS_PER_GOAL,
     TORCH_THREADS,
@@ -238,20 +239,12 @@ def run_race(
 
 def _started(out: Path, first: RaceRun) -> dict:
     """race.json: written for a new directory, or read back."""
-    path = out / RACE_FILE
-    if path.exists():
-        try:
-            record = storage.read_json(path)
-            record["settings"]  # noqa: B018  (a record without it is damaged)
-        except (storage.CorruptFileError, KeyError, TypeError):
-            raise RaceError(f"{path} is damaged: remove {out} to run it again") from None
-        return record
-    if out.exists() and any(p.name != ".lock" for p in out.iterdir()):
-        raise RaceError(f"{out} is not empty and holds no race: give another --out")
-    record = {
-        "settings": first.shared(),
-        "sac_her": learner_values(),
-        "sac_her_defaults": library_defaults(),
-    }
-    storage.write_json(path, record)
-    return record
+
+    def new() -> dict:
+        return {
+            "settings": first.shared(),
+            "sac_her": learner_values(),
+            "sac_her_defaults": library_defaults(),
+        }
+
+    return opened_record(out, RACE_FILE, "race", RaceError, new)
