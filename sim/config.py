@@ -146,7 +146,7 @@ class WorldConfig:
     held_pose: str = dataclasses.field(
         default="touch", metadata={BEFORE: "touch", ACTS_ON: ("physical",)}
     )
-    # A part of the contact step unbundled (issue 51), never a default: what the physical
+    # A part of the contact step unbundled, never a default: what the physical
     # backend's objects do where something touches them. "solid": they push back (pushed, or
     # held still by the table with push_objects false: then they block the hand and what it
     # holds); "sensed": the touch is found, and the grasp's contact sensors read it as they
@@ -156,7 +156,7 @@ class WorldConfig:
     unheld_contacts: str = dataclasses.field(
         default="solid", metadata={BEFORE: "solid", ACTS_ON: ("physical",)}
     )
-    # A part of the contact step unbundled (issue 51), never a default: how the physical
+    # A part of the contact step unbundled, never a default: how the physical
     # backend's caregiver carries the toy she brings. "welded": her hand, a mocap body, welded
     # to the toy, which follows it through the dynamics (sim/grasping/carrying.py); "placed":
     # the toy itself put at each control step's point of her path, as the kinematic rules
@@ -164,7 +164,7 @@ class WorldConfig:
     caregiver_carrying: str = dataclasses.field(
         default="welded", metadata={BEFORE: "welded", ACTS_ON: ("physical",)}
     )
-    # A part of the contact step unbundled (issue 51), never a default: True places the
+    # A part of the contact step unbundled, never a default: True places the
     # kinematic backend's toys as the physical backend must place its solid ones, each clear
     # of the others and of the stick (sim/experimenter.py PLACEMENT_CLEARANCE); False places
     # them anywhere in their rings, as the study did. The physical backend always places clear.

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from experiments.baseline.control_settings import CONTROL, DEFAULTS, ControlError
+from experiments.baseline.control_settings import CONTROL, DEFAULTS, ControlError, check_counts
 
 if TYPE_CHECKING:  # the command line's help reads this module: it loads no batch or world
     from experiments.run.settings import TrialSettings
@@ -59,10 +59,7 @@ class RaceRun:
     def __post_init__(self) -> None:
         if self.learner not in LEARNERS:
             raise RaceError(f"unknown learner {self.learner!r}: one of {', '.join(LEARNERS)}")
-        for name in ("eval_every", "eval_goals"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise RaceError(f"{name} must be an integer >= 1, got {value!r}")
+        check_counts(self, {"eval_every": 1, "eval_goals": 1}, RaceError)
         if self.movements % self.eval_every:
             raise RaceError(
                 f"the trials' iterations ({self.movements}) must be a multiple of the tests' "

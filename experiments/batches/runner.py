@@ -303,7 +303,7 @@ def run_batch(
     results: dict[str, dict] = {}
     failures: dict[str, str] = {}
     listening = recorded = made = False
-    token = out / "none"
+    token: Path | None = None  # the run's token file, once written
     try:  # from here on, the cluster this batch started is closed however the batch ends
         where = scheduler or "the batch's local cluster"
         workers.wait_for_workers(client, where, worker_wait_s)
@@ -365,7 +365,8 @@ def run_batch(
         logging.getLogger("distributed").setLevel(logging.CRITICAL)
         raise
     finally:
-        workers.remove_token(token)
+        if token is not None:
+            workers.remove_token(token)
         if not recorded:  # refused before anything was written: the directory made now goes
             workers.undo_created(out, made)
         try:

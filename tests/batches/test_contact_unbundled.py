@@ -1,4 +1,4 @@
-"""The contact step unbundled and the contact factorial (issue 51): batch configs each of whose
+"""The contact step unbundled and the contact factorial: batch configs each of whose
 rungs or cells changes one rule (experiments/batches/contact-unbundled/, held-pose-returns/,
 contact-factorial/), every one the comparison's setting, every agent tested in both worlds."""
 

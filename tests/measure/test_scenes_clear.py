@@ -1,4 +1,4 @@
-"""Evaluation scenes clear of the stick (issue 51; docs/protocol.md D20): a named evaluation
+"""Evaluation scenes clear of the stick (docs/protocol.md D20): a named evaluation
 setting, never the default. By default some ring-1 scenes of the evaluation's seed start with a
 toy on the stick at its start pose, where the physical backend's learning placements never put
 one; with `scenes_clear_of_stick` none does, and eval.json says so."""

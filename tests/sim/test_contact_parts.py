@@ -1,4 +1,4 @@
-"""The contact step's parts, each a world setting of its own (issue 51): touches sensed but
+"""The contact step's parts, each a world setting of its own: touches sensed but
 exerting no force (`unheld_contacts`), the caregiver's toy placed on her path rather than
 welded to her hand (`caregiver_carrying`), the kinematic toys placed clear of each other and of
 the stick (`placements_clear`). Each default is the room as it was."""
