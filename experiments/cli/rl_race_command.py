@@ -73,6 +73,24 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help=f"torch's CPU threads a run (default: {TORCH_THREADS})",
     )
     p.set_defaults(func=cmd_rl_race)
+    lookup = sub.add_parser(
+        "rl-race-lookup",
+        help="a finished race's Model Babbling asked by where the toy starts and ends",
+        description=LOOKUP_DESCRIPTION,
+    )
+    lookup.add_argument("race", help="a race's directory (playroom rl-race --out)")
+    lookup.set_defaults(func=cmd_rl_race_lookup)
+
+
+LOOKUP_DESCRIPTION = (
+    "How much of Model Babbling's race score is the question it is asked "
+    "(experiments/baseline/race_lookup.py): every Model Babbling trial of a finished race, at "
+    "its final movements, tested again on the race's held-out goals with its memory looked up "
+    "by the toy's start and end (the experience nearest in context, start and end, replayed) "
+    "instead of by the study's straight goal trajectory. Writes RACE/rl-race-lookup.csv (grasp, "
+    "seed, steps, question, ring, goals, success) and rl-race-lookup-summary.csv (means over "
+    "the trials and the Wilcoxon signed-rank p of the difference), and prints the summary."
+)
 
 
 def cmd_rl_race(args: argparse.Namespace) -> None:
@@ -108,3 +126,16 @@ def cmd_rl_race(args: argparse.Namespace) -> None:
     except RaceError as exc:
         raise UsageError(str(exc)) from None
     print(f"{table}: the curves of {len(runs)} runs (and {CLAIMS}, rl-race.png, rl-race.json)")
+
+
+def cmd_rl_race_lookup(args: argparse.Namespace) -> None:
+    from experiments.baseline.race_lookup import LOOKUP_TABLE, lookup_summary, race_lookup
+    from experiments.baseline.race_settings import RaceError
+
+    try:
+        table = race_lookup(args.race)
+    except RaceError as exc:
+        raise UsageError(str(exc)) from None
+    print(lookup_summary(table).to_string(index=False, float_format="%.4g"))
+    trials = len(table[["grasp", "seed"]].drop_duplicates())
+    print(f"{os.path.join(args.race, LOOKUP_TABLE)}: {trials} trials asked both ways")
