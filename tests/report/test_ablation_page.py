@@ -41,12 +41,8 @@ def _batch(name: str, competence: np.ndarray, gaps: list[float], **overrides):
     words = [_words(g, 0.01 * k) for k, g in enumerate(gaps)]
     results = batch("kinematic", SEEDS, competence=competence, words=words)
     config = full_config(TrialSettings(grasp="kinematic", overrides=overrides))
-    trials = results.trials.assign(grasp="kinematic")
     return dataclasses.replace(
-        results,
-        batch_dir=results.batch_dir.with_name(name),
-        trials=trials,
-        configs={"kinematic": config},
+        results, batch_dir=results.batch_dir.with_name(name), configs={"kinematic": config}
     )
 
 
