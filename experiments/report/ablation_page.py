@@ -7,17 +7,14 @@ the two (experiments/report/ablation_tests.py); a link to the per-trial data bes
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from experiments.analysis import step_split
 from experiments.analysis.stats import STRATEGIES
 from experiments.analysis.trial_tests import ALPHA, survives
 from experiments.report import ablation_data, ablation_tests
+from experiments.report.ablation_tests import AblationRow
 from experiments.report.measures import GAP, Measure
 from experiments.report.pages import p_value
-
-if TYPE_CHECKING:
-    from experiments.report.ablations import AblationRow
 
 # The study's regions, in the order the table shows them (experiments.measure.study_measure).
 STUDY_REGIONS = ("centre", "between_limits", "distance_1")

@@ -1,4 +1,5 @@
-"""The ablation table's measures (those of the registry marked `in_ablations`,
+"""The ablation table's numbers (`AblationRow`: one configuration's; `AblationNumbers`: one
+measure's on it) and its measures (those of the registry marked `in_ablations`,
 experiments/report/measures.py), tested over trials: each configuration's per-trial
 values against the baseline's on the same seeds (the paired t test of their differences, and
 beside it Wilcoxon's signed-rank test of the same differences), a gap measure's values also
@@ -60,6 +61,25 @@ class AblationNumbers:
     rank_holm_p: float = math.nan
     within_rank_holm_p: float = math.nan
     against_baseline: bool = False
+
+
+@dataclass(frozen=True)
+class AblationRow:
+    """One configuration's numbers; shares are fractions, NaN where not measured."""
+
+    label: str
+    batch: str
+    group: str
+    n_trials: int
+    study_competence: float
+    study_strategies: dict[str, dict[str, float]]  # region -> strategy -> share
+    # The registry's measures of this table (name -> numbers over trials, paired by seed).
+    measures: dict[str, AblationNumbers]
+    # The study's numbers on the pooled words: medians, and the Mann-Whitney p of names vs
+    # distractors, two-sided as the study (the one-sided p doubled); treats words as independent.
+    median_names: float
+    median_distractors: float
+    pooled_names_vs_distractors_p_two_sided: float
 
 
 def ablation_measures(measures: tuple[Measure, ...]) -> tuple[Measure, ...]:

@@ -31,7 +31,7 @@ import math
 import os
 import re
 import textwrap
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import pandas as pd
@@ -45,7 +45,7 @@ from experiments.analysis.stats import STRATEGIES, vocal_summary
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
 from experiments.report import ablation_data, ablation_tests, paper
 from experiments.report.ablation_page import STUDY_REGIONS, markdown
-from experiments.report.ablation_tests import AblationNumbers
+from experiments.report.ablation_tests import AblationRow
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
 from experiments.report.measures import Measure, registry
 from experiments.report.pages import pct
@@ -56,25 +56,6 @@ BOOKKEEPING = ("trial.preset", "trial.overrides")
 MIRRORED = ("world.stick_return", "world.voice")
 # The measure whose paired differences the figure's left panel draws.
 COMPETENCE = "competence_all"
-
-
-@dataclass(frozen=True)
-class AblationRow:
-    """One configuration's numbers; shares are fractions, NaN where not measured."""
-
-    label: str
-    batch: str
-    group: str
-    n_trials: int
-    study_competence: float
-    study_strategies: dict[str, dict[str, float]]  # region -> strategy -> share
-    # The registry's measures of this table (name -> numbers over trials, paired by seed).
-    measures: dict[str, AblationNumbers]
-    # The study's numbers on the pooled words: medians, and the Mann-Whitney p of names vs
-    # distractors, two-sided as the study (the one-sided p doubled); treats words as independent.
-    median_names: float
-    median_distractors: float
-    pooled_names_vs_distractors_p_two_sided: float
 
 
 def describe_change(baseline: dict, config: dict) -> str:
@@ -156,9 +137,9 @@ def _rows_and_measures(
     baseline = baseline.with_seeds(seeds)
     measures = ablation_tests.ablation_measures(registry(Geometry.of(baseline)))
     label = f"baseline ({baseline.batch_dir.name})"
-    mine = [g for g in baseline.groups if any(g == group for _, group in pairs)]
-    rows = [_row(baseline, g, label, room, measures, None) for g in mine]
-    trials = [ablation_data.row_trials(baseline.select(g), label, True, measures) for g in mine]
+    shared = [g for g in baseline.groups if any(g == group for _, group in pairs)]
+    rows = [_row(baseline, g, label, room, measures, None) for g in shared]
+    trials = [ablation_data.row_trials(baseline.select(g), label, True, measures) for g in shared]
     several = len(baseline.groups) > 1
     for results, group in pairs:
         label = describe_change(baseline.configs[group], results.configs[group])

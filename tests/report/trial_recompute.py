@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -77,3 +78,16 @@ def check_tests_again(trials: pd.DataFrame, tests: list[dict]) -> None:
     for test, a in zip(tests, again, strict=True):
         if test["difference"] is not None:
             assert test["difference"] == _approx(a["difference"]), test
+
+
+def check_trials_file(out: Path, page: str, tests: list[dict]) -> pd.DataFrame:
+    """comparison-trials.csv beside a comparison page written into `out` (`page` its HTML,
+    `tests` its summary.json's tests): linked from the page, who learned and evaluated each
+    trial recorded, and every test of the page computed again from it. Returns the table."""
+    assert 'href="comparison-trials.csv"' in page
+    trials = pd.read_csv(out / "comparison-trials.csv")
+    assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}(\+dirty)?").all()
+    assert trials["computed_on"].str.contains("from iteration 0").all()
+    assert trials["evaluated_on"].ne("not recorded").all()
+    check_tests_again(trials, tests)
+    return trials
