@@ -80,16 +80,19 @@ comparison: $(INSTALLED)
 	$(BIN)/playroom compare $(OUT)/comparison $(OUT)/comparison --out $(OUT)/comparison-report
 
 ## comparison-diva: both backends with the study's vocal tract, DIVA, at the study's scale (the
-## comparison-diva profile: 64 seeds x 80000 each, study preset) and their comparison page;
+## comparison-diva profile: 64 seeds x 80000 each, study preset) and their comparison page, its
+## per-trial data (comparison-trials.csv) copied into docs/data/ (docs/comparison.md quotes it);
 ## needs DIVA's data (`playroom voice-data diva PATH`); hours on 2 cores, resumes
 comparison-diva: $(INSTALLED)
 	$(BIN)/playroom batch --profile comparison-diva --out $(OUT)/comparison-diva
 	$(BIN)/playroom compare $(OUT)/comparison-diva $(OUT)/comparison-diva \
 		--out $(OUT)/comparison-diva-report
+	mkdir -p docs/data
+	cp $(OUT)/comparison-diva-report/comparison-trials.csv docs/data/comparison-diva-trials.csv
 
 ## contact-ablations: each switch of experiments/batches/contact-ablations/ on the physical
 ## backend with DIVA (32 seeds x 80000), against the same seeds of comparison-diva's physical
-## trials (`playroom ablations`)
+## trials (`playroom ablations`), its per-trial data copied into docs/data/
 CONTACT_ABLATIONS := $(basename $(notdir $(wildcard experiments/batches/contact-ablations/*.json)))
 contact-ablations: comparison-diva
 	for name in $(CONTACT_ABLATIONS); do \
@@ -98,6 +101,8 @@ contact-ablations: comparison-diva
 	done
 	$(BIN)/playroom ablations $(OUT)/comparison-diva \
 		$(addprefix $(OUT)/contact-ablation-,$(CONTACT_ABLATIONS)) --out $(OUT)/contact-ablations
+	mkdir -p docs/data
+	cp $(OUT)/contact-ablations/ablations-trials.csv docs/data/contact-ablations-trials.csv
 
 ## contact-ladder: the rungs from the study's kinematic rules to the physical backend, one
 ## rule changed per rung (experiments/batches/contact-ladder/NN-name.json, 32 seeds x 80000 with
@@ -183,7 +188,8 @@ contact-factorial: contact-ladder
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the
-## project preset), 32 seeds x 80000 each, then both tables (`playroom ablations`)
+## project preset), 32 seeds x 80000 each, then both tables (`playroom ablations`), their
+## per-trial data copied into docs/data/ (docs/replication.md quotes them)
 ABLATIONS := $(basename $(notdir $(wildcard experiments/batches/ablations/*.json)))
 FROM_STUDY := $(filter-out project%,$(ABLATIONS))
 FROM_PROJECT := $(filter project-plus-%,$(ABLATIONS))
@@ -196,6 +202,10 @@ ablations: replicate
 		--out $(OUT)/ablations-from-study
 	$(BIN)/playroom ablations $(OUT)/ablation-project $(addprefix $(OUT)/ablation-,$(FROM_PROJECT)) \
 		--out $(OUT)/ablations-from-project
+	mkdir -p docs/data
+	cp $(OUT)/ablations-from-study/ablations-trials.csv docs/data/ablations-from-study-trials.csv
+	cp $(OUT)/ablations-from-project/ablations-trials.csv \
+		docs/data/ablations-from-project-trials.csv
 
 # The suite runs in as many processes as the machine has cores (pytest-xdist), a test file
 # to a process, so that each file's fixtures are made once.

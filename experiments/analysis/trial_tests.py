@@ -6,9 +6,11 @@ independent (χ² or Fisher on pooled counts) reports a certainty the batch does
 difference is therefore tested on one value per trial:
 - `difference_test`: two groups. Paired over seeds (Student's t on the per-seed differences,
   `scipy.stats.ttest_rel`) where both groups hold the same seeds, since a seed fixes the
-  placements and the first random draws of both agents; Welch's t otherwise.
+  placements and the first random draws of both agents; Welch's t otherwise. Beside the t, a
+  nonparametric p on the same values (`rank_method`, `rank_p`): Wilcoxon's signed-rank test of
+  the per-seed differences where paired, the Mann-Whitney U test (stats.mann_whitney) where not.
 - `one_sample_test`: one group's per-trial values against 0 (e.g. each trial's gap between
-  its distractors and its names).
+  its distractors and its names), with the signed-rank test of the values against 0 beside it.
 - `signed_rank_p`: the Wilcoxon signed-rank test's p of paired differences, shown beside every
   paired t where the pages give a nonparametric p (experiments/analysis/step_split.py).
 - `holm`: Holm's step-down adjustment of a page's p-values for the number of tests it makes
@@ -33,13 +35,17 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from experiments.analysis.stats import welch
+from experiments.analysis.stats import mann_whitney, welch
 
 # The family-wise error rate Holm's correction holds the page's tests to.
 ALPHA = 0.05
 PAIRED = "paired t over seeds"
 WELCH = "Welch t"
 ONE_SAMPLE = "one-sample t against 0"
+# The nonparametric test beside each t above, in the same order.
+SIGNED_RANK = "Wilcoxon signed-rank over seeds"
+MANN_WHITNEY = "Mann-Whitney U"
+SIGNED_RANK_ZERO = "Wilcoxon signed-rank against 0"
 
 
 @dataclass(frozen=True)
@@ -47,7 +53,8 @@ class TrialTest:
     """A test on per-trial values. `statistic` is t of the first group minus the second (or of
     the values against 0); `n` the values used per group (pairs: the number of pairs, twice);
     `difference` the mean difference (paired), difference of means (Welch) or mean (one
-    sample)."""
+    sample); `rank_p` the two-sided p of the nonparametric test `rank_method` on the same
+    values, NaN wherever the t has no p (so that both kinds of p count the same tests)."""
 
     method: str
     statistic: float
@@ -55,6 +62,8 @@ class TrialTest:
     n: tuple[int, ...]
     paired: bool
     difference: float
+    rank_method: str
+    rank_p: float
 
 
 @dataclass(frozen=True)
@@ -100,16 +109,17 @@ def difference_test(a: pd.Series, b: pd.Series, paired: bool) -> TrialTest:
         x, y = paired_arrays(a, b)
         d = x - y
         mean = float(d.mean()) if len(d) else math.nan
+        n = (len(d), len(d))
         if len(d) < 2 or _constant(d):
-            return TrialTest(PAIRED, math.nan, math.nan, (len(d), len(d)), True, mean)
+            return TrialTest(PAIRED, math.nan, math.nan, n, True, mean, SIGNED_RANK, math.nan)
         result = stats.ttest_rel(x, y)
-        return TrialTest(
-            PAIRED, float(result.statistic), float(result.pvalue), (len(d), len(d)), True, mean
-        )
+        t, p = float(result.statistic), float(result.pvalue)
+        return TrialTest(PAIRED, t, p, n, True, mean, SIGNED_RANK, signed_rank_p(d))
     x, y = _finite(a.to_numpy()), _finite(b.to_numpy())
     mean = float(x.mean() - y.mean()) if len(x) and len(y) else math.nan
     t, p = welch(x, y)
-    return TrialTest(WELCH, t, p, (len(x), len(y)), False, mean)
+    rank = mann_whitney(x, y)[1] if math.isfinite(p) else math.nan
+    return TrialTest(WELCH, t, p, (len(x), len(y)), False, mean, MANN_WHITNEY, rank)
 
 
 def one_sample_test(values: pd.Series) -> TrialTest:
@@ -117,14 +127,15 @@ def one_sample_test(values: pd.Series) -> TrialTest:
     x = _finite(values.to_numpy())
     mean = float(x.mean()) if len(x) else math.nan
     if len(x) < 2 or _constant(x):
-        return TrialTest(ONE_SAMPLE, math.nan, math.nan, (len(x),), False, mean)
+        return TrialTest(
+            ONE_SAMPLE, math.nan, math.nan, (len(x),), False, mean, SIGNED_RANK_ZERO, math.nan
+        )
     with warnings.catch_warnings():
         # Nearly constant values: scipy warns of precision loss; the test is still reported.
         warnings.simplefilter("ignore", RuntimeWarning)
         result = stats.ttest_1samp(x, 0.0)
-    return TrialTest(
-        ONE_SAMPLE, float(result.statistic), float(result.pvalue), (len(x),), False, mean
-    )
+    t, p = float(result.statistic), float(result.pvalue)
+    return TrialTest(ONE_SAMPLE, t, p, (len(x),), False, mean, SIGNED_RANK_ZERO, signed_rank_p(x))
 
 
 # Why Wilcoxon's signed-rank test and not a sign-flip permutation of the seeds

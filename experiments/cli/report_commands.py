@@ -36,7 +36,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("ablations", help="batches changing a setting, against a baseline")
     p.add_argument("baseline", help="the baseline batch directory (e.g. the replication)")
     p.add_argument("batches", nargs="+", help="batch directories, each changing a setting")
-    p.add_argument("--out", required=True, help="where to write ablations.md/.csv/.png")
+    p.add_argument(
+        "--out", required=True, help="where to write ablations.md/.csv/.png, ablations-trials.csv"
+    )
     study_reference_option(p)
     p.set_defaults(func=cmd_ablations)
 
@@ -74,6 +76,7 @@ def cmd_compare(args: argparse.Namespace) -> None:
 def cmd_ablations(args: argparse.Namespace) -> None:
     """Batches that change a setting or two, against a baseline batch, paired by seed."""
     from experiments.analysis.results import ReportError
+    from experiments.report import ablation_data
     from experiments.report.ablations import write_ablations
 
     try:
@@ -84,7 +87,7 @@ def cmd_ablations(args: argparse.Namespace) -> None:
     except ReportError as exc:
         raise UsageError(str(exc)) from None
     print(table.read_text(), end="")
-    print(f"written: {table}, {table.with_name('ablations.csv').name}, ablations.png")
+    print(f"written: {table}, ablations.csv, {ablation_data.FILE}, ablations.png")
 
 
 def _grasp_rate_commands(args: argparse.Namespace) -> dict:

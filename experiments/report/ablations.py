@@ -13,13 +13,16 @@ Numbers per row: the competence and strategy shares as the study computed them
 (experiments/report/measures.py: the project's competence, each trial's share of words
 imitated within the recognition distance, each trial's gap between its distractors and its
 names), each a mean over the row's trials with the mean paired difference from the baseline
-(95% interval, paired t test over seeds, two-sided), the gap also against 0 within the row;
-Holm's correction over every test of the table (experiments/report/ablation_tests.py). Then,
-as the study reported them, the median best distance of the pooled names and distractors and
-their Mann-Whitney test on the pooled words, its p two-sided as the study computed it (the
-one-sided p doubled): a second line, which treats words as independent. Written:
-ablations.md (the table), ablations.csv (every number, unrounded), ablations.png (the paired
-differences and the names effect, one line per row).
+(95% interval, paired t test over seeds, two-sided, the Wilcoxon signed-rank p beside it), the
+gap also against 0 within the row; Holm's correction over the table's one family of tests, for
+each kind of p (experiments/report/ablation_tests.py). Then, as the study reported them, the
+median best distance of the pooled names and distractors and their Mann-Whitney test on the
+pooled words, its p two-sided as the study computed it (the one-sided p doubled): a second
+line, which treats words as independent. Written: ablations.md (the table, its family of tests
+and the cells whose star differs between the two tests: experiments/report/ablation_page.py),
+ablations.csv (every number, unrounded), ablations-trials.csv (every trial's values and who
+computed it: experiments/report/ablation_data.py), ablations.png (the paired differences and
+the names effect, one line per row).
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import math
 import os
 import re
 import textwrap
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import pandas as pd
@@ -39,41 +42,20 @@ from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import STRATEGIES, vocal_summary
-from experiments.analysis.trial_tests import ALPHA
 from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
-from experiments.report import ablation_tests, paper
-from experiments.report.ablation_tests import AblationNumbers
+from experiments.report import ablation_data, ablation_tests, paper
+from experiments.report.ablation_page import STUDY_REGIONS, markdown
+from experiments.report.ablation_tests import AblationRow
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
-from experiments.report.measures import GAP, Measure, registry
+from experiments.report.measures import Measure, registry
 from experiments.report.pages import pct
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
 BOOKKEEPING = ("trial.preset", "trial.overrides")
 # The world's copies of trial settings: a row says "trial.voice: vtl -> diva" once, not twice.
 MIRRORED = ("world.stick_return", "world.voice")
-# The study's regions, in the order the table shows them (experiments.measure.study_measure).
-STUDY_REGIONS = ("centre", "between_limits", "distance_1")
 # The measure whose paired differences the figure's left panel draws.
 COMPETENCE = "competence_all"
-
-
-@dataclass(frozen=True)
-class AblationRow:
-    """One configuration's numbers; shares are fractions, NaN where not measured."""
-
-    label: str
-    batch: str
-    group: str
-    n_trials: int
-    study_competence: float
-    study_strategies: dict[str, dict[str, float]]  # region -> strategy -> share
-    # The registry's measures of this table (name -> numbers over trials, paired by seed).
-    measures: dict[str, AblationNumbers]
-    # The study's numbers on the pooled words: medians, and the Mann-Whitney p of names vs
-    # distractors, two-sided as the study (the one-sided p doubled); treats words as independent.
-    median_names: float
-    median_distractors: float
-    pooled_names_vs_distractors_p_two_sided: float
 
 
 def describe_change(baseline: dict, config: dict) -> str:
@@ -123,18 +105,21 @@ def ablation_rows(
     """The baseline's row first, then one row per group of each batch that the baseline also
     holds, with Holm's adjustment over the table's tests. ReportError (one line) for a batch
     that cannot be read or shares no group and no seed with the baseline."""
-    return _rows_and_measures(baseline_dir, batch_dirs, measures)[0]
+    return _rows_and_measures(*_read(baseline_dir, batch_dirs), measures)[0]
+
+
+def _read(
+    baseline_dir: str | os.PathLike, batch_dirs: list[str | os.PathLike]
+) -> tuple[BatchResults, list[BatchResults]]:
+    if not batch_dirs:
+        raise ReportError("give at least one batch to compare with the baseline")
+    return collect(baseline_dir), [collect(d) for d in batch_dirs]
 
 
 def _rows_and_measures(
-    baseline_dir: str | os.PathLike,
-    batch_dirs: list[str | os.PathLike],
-    room: RoomMeasures,
-) -> tuple[list[AblationRow], tuple[Measure, ...]]:
-    if not batch_dirs:
-        raise ReportError("give at least one batch to compare with the baseline")
-    baseline = collect(baseline_dir)
-    batches = [collect(d) for d in batch_dirs]
+    baseline: BatchResults, batches: list[BatchResults], room: RoomMeasures
+) -> tuple[list[AblationRow], tuple[Measure, ...], pd.DataFrame]:
+    """The rows, the table's measures and every row's trials (ablation_data)."""
     seeds: set[int] = set()
     pairs = []
     for results in batches:
@@ -151,73 +136,19 @@ def _rows_and_measures(
         pairs += [(results, g) for g in groups]
     baseline = baseline.with_seeds(seeds)
     measures = ablation_tests.ablation_measures(registry(Geometry.of(baseline)))
-    rows = [
-        _row(baseline, g, f"baseline ({baseline.batch_dir.name})", room, measures, None)
-        for g in baseline.groups
-        if any(g == group for _, group in pairs)
-    ]
+    label = f"baseline ({baseline.batch_dir.name})"
+    shared = [g for g in baseline.groups if any(g == group for _, group in pairs)]
+    rows = [_row(baseline, g, label, room, measures, None) for g in shared]
+    trials = [ablation_data.row_trials(baseline.select(g), label, True, measures) for g in shared]
     several = len(baseline.groups) > 1
     for results, group in pairs:
         label = describe_change(baseline.configs[group], results.configs[group])
         label = f"{label} [{group}]" if several else label
         rows.append(_row(results, group, label, room, measures, baseline))
-    adjusted = ablation_tests.with_holm([row.measures for row in rows])
-    return [replace(r, measures=m) for r, m in zip(rows, adjusted, strict=True)], measures
-
-
-def _percent(value: float, digits: int = 0) -> str:
-    return "n/a" if not math.isfinite(value) else f"{100 * value:.{digits}f}%"
-
-
-def _shares(row: AblationRow, region: str) -> str:
-    shares = row.study_strategies.get(region)
-    if not shares:
-        return "n/a"
-    return "/".join(f"{100 * shares.get(s, 0.0):.0f}" for s in STRATEGIES)
-
-
-def _number(value: float, form: str) -> str:
-    return "n/a" if not math.isfinite(value) else format(value, form)
-
-
-def markdown_table(rows: list[AblationRow], measures: tuple[Measure, ...]) -> str:
-    """The table of `ablation_rows` in Markdown, `measures` its registry columns, with a line
-    under it of how many tests it makes and how many survive Holm's correction."""
-    gaps = [m for m in measures if m.test == GAP]
-    head = [
-        "configuration",
-        "trials",
-        "competence, study's measure",
-        "hand/tool/vocal centre",
-        "between limits",
-        "distance 1",
-        *(ablation_tests.header(m) for m in measures),
-        *(f"{m.short or m.label}: against 0, one-sample t p over trials" for m in gaps),
-        "median names / distractors (pooled words)",
-        "names vs distractors pooled over words (Mann-Whitney two-sided p, one-sided doubled as "
-        "the study; treats words as independent)",
-    ]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for row in rows:
-        cells = [
-            row.label,
-            str(row.n_trials),
-            _percent(row.study_competence),
-            *(_shares(row, region) for region in STUDY_REGIONS),
-            *(ablation_tests.cell(m, row.measures[m.name]) for m in measures),
-            *(ablation_tests.within_cell(row.measures[m.name]) for m in gaps),
-            f"{_number(row.median_names, '.2f')} / {_number(row.median_distractors, '.2f')}",
-            _number(row.pooled_names_vs_distractors_p_two_sided, ".2g"),
-        ]
-        lines.append("| " + " | ".join(cells) + " |")
-    made, kept = ablation_tests.count_tests([row.measures for row in rows])
-    lines.append("")
-    lines.append(
-        f"{made} tests over trials; {kept} survive Holm's correction for that number "
-        f"(family-wise α = {ALPHA:g}), marked in their cells. The last column pools the words of "
-        "every trial and is not counted."
-    )
-    return "\n".join(lines) + "\n"
+        trials.append(ablation_data.row_trials(results.select(group), label, False, measures))
+    adjusted = ablation_tests.with_holm([row.measures for row in rows], measures)
+    rows = [replace(r, measures=m) for r, m in zip(rows, adjusted, strict=True)]
+    return rows, measures, ablation_data.trial_table(trials)
 
 
 def csv_table(rows: list[AblationRow]) -> pd.DataFrame:
@@ -338,6 +269,19 @@ def ablation_figure(rows: list[AblationRow]) -> Figure:
     return fig
 
 
+def ablation_files(
+    baseline: BatchResults, batches: list[BatchResults], room: RoomMeasures
+) -> dict[str, bytes]:
+    """Every file of the table (the table last) from the baseline's and the batches' results."""
+    rows, columns, trials = _rows_and_measures(baseline, batches, room)
+    return {
+        ABLATION_CSV_FILE: csv_table(rows).to_csv(index=False).encode(),
+        ablation_data.FILE: trials.to_csv(index=False).encode(),
+        ABLATION_FIGURE_FILE: png_bytes(ablation_figure(rows)),
+        ABLATION_TABLE_FILE: markdown(rows, columns).encode(),
+    }
+
+
 def write_ablations(
     baseline_dir: str | os.PathLike,
     batch_dirs: list[str | os.PathLike],
@@ -345,16 +289,9 @@ def write_ablations(
     *,
     measures: RoomMeasures,
 ) -> Path:
-    """Compute the rows, then write the CSV, the figure and the table into out_dir as one unit
-    (after everything was computed; a failed write leaves nothing). Returns the table's path."""
+    """Compute the rows, then write the CSV, the per-trial data, the figure and the table into
+    out_dir as one unit (after everything was computed; a failed write leaves nothing). Returns
+    the table's path."""
     check_out_dir(Path(out_dir))
-    rows, columns = _rows_and_measures(baseline_dir, batch_dirs, measures)
-    table = markdown_table(rows, columns)
-    figure = png_bytes(ablation_figure(rows))
-    csv = csv_table(rows).to_csv(index=False)
-    files = {
-        ABLATION_CSV_FILE: csv.encode(),
-        ABLATION_FIGURE_FILE: figure,
-        ABLATION_TABLE_FILE: table.encode(),
-    }
+    files = ablation_files(*_read(baseline_dir, batch_dirs), measures)
     return storage.write_files(Path(out_dir), files)[-1]

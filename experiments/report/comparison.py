@@ -2,7 +2,11 @@
 panel per side, the paper table with both, and tests of whether their differences are real.
 
 A side is one group of trials: two batches of one group each (e.g. kinematic and physical
-grasping run apart), or one batch of exactly two groups compared with itself.
+grasping run apart), or one batch of exactly two groups compared with itself. Every t of the
+table of differences has a nonparametric p beside it, each kind Holm-adjusted over the page's
+one family (experiments/report/differences.py), and the cells whose star differs between the
+two are named; every trial's values are written beside the page (comparison-trials.csv,
+experiments/report/comparison_data.py).
 """
 
 from __future__ import annotations
@@ -17,8 +21,10 @@ from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.trial_tests import ALPHA
+from experiments.analysis.trial_values import VALUE
 from experiments.file_names import COMPARISON_FILE
 from experiments.report import (
+    comparison_data,
     differences,
     intro,
     name_strategies,
@@ -33,6 +39,7 @@ from experiments.report.measures import registry
 from experiments.report.mechanism_figures import mechanism_figures
 from experiments.report.pages import (
     Table,
+    p_value,
     pct,
     render,
     settings_table,
@@ -105,9 +112,11 @@ def difference_table(
         "test over trials",
         "p (two-sided)",
         f"survives Holm ({tested} tests, α = {ALPHA:g})",
+        "nonparametric test beside it: p (two-sided)",
+        f"its p survives Holm ({tested} tests, α = {ALPHA:g})",
     ]
     rows = differences.rows(evaluated, a, b)
-    rows += [[*r, ""] for r in _grasp_rate_row(a, b, grasp_rate_commands, room)]
+    rows += [[*r, "", "", ""] for r in _grasp_rate_row(a, b, grasp_rate_commands, room)]
     return Table(header, rows), evaluated
 
 
@@ -121,11 +130,37 @@ def tests_note(evaluated: list[differences.Evaluated]) -> str:
         if paired and all(paired)
         else "Welch's t (the sides do not hold the same seeds, so they do not pair)"
     )
+    rank = (
+        "the Wilcoxon signed-rank test of the same differences"
+        if paired and all(paired)
+        else "the Mann-Whitney U test of the same values"
+    )
     return (
         f"This table makes {summary['count']} tests on per-trial values, {how}; "
         f"{summary['survive']} of them survive Holm's correction for that number "
-        f"(family-wise α = {ALPHA:g})."
+        f"(family-wise α = {ALPHA:g}). Beside each t, a nonparametric test: {rank} (the "
+        "signed-rank test of the values where a gap is tested against 0), Holm-adjusted over "
+        f"the same tests: {summary['survive_rank']} survive. The family, fixed by the measures "
+        f"and the sides before any value is compared: {differences.FAMILY}."
     )
+
+
+def disagreement_lines(evaluated: list[differences.Evaluated]) -> list[str]:
+    """Every cell whose Holm verdict differs between the t and the nonparametric test beside
+    it, as a line naming the measure, the part and both ps."""
+    lines = []
+    for e in evaluated:
+        for o in e.outcomes:
+            if not np.isfinite(o.test.p) or o.survives == o.rank_survives:
+                continue
+            part = "" if o.part == VALUE else f", {o.part}"
+            starred = "the t" if o.survives else o.test.rank_method
+            lines.append(
+                f"{e.measure.label}{part}: survives Holm with {starred} only "
+                f"({o.test.method} {p_value(o.test.p)}; {o.test.rank_method} "
+                f"{p_value(o.test.rank_p)})"
+            )
+    return lines
 
 
 def write_comparison(
@@ -140,8 +175,10 @@ def write_comparison(
     panel per batch, the paper table with both, tests of their differences and the cost per
     iteration of each, and the stick's numbers (with `grasp_rate_commands` random commands
     played in both backends). `dir_a` may equal `dir_b` for one batch of exactly two groups. Writes
-    `comparison.html`, `comparison-*.png` and the page's numbers (`summary.json`,
-    `summary.csv`: experiments/report/summary.py) into out_dir; returns the page's path."""
+    `comparison.html`, `comparison-*.png`, the page's numbers (`summary.json`,
+    `summary.csv`: experiments/report/summary.py) and every trial's values
+    (`comparison-trials.csv`: experiments/report/comparison_data.py) into out_dir; returns the
+    page's path."""
     dir_a, dir_b = Path(dir_a), Path(dir_b)
     a, b = _sides(dir_a, dir_b)
     check_out_dir(Path(out_dir))
@@ -166,6 +203,8 @@ def write_comparison(
         backend_rules=rules_text(merged.configs),
         tests=tests,
         tests_note=tests_note(evaluated),
+        disagreements=disagreement_lines(evaluated),
+        trials_file=comparison_data.FILE,
         paper_table=paper.paper_table(merged, numbers, geometry, prefix=""),
         paper=published,
         reference=paper.reference(),
@@ -191,4 +230,7 @@ def write_comparison(
     # Both definitions of "tool", with intervals over trials (like with like).
     for group, numbers_of in strategy_definitions.summary_numbers(merged, geometry).items():
         content["by_group"][group]["strategy_definitions"] = numbers_of
-    return write_page(Path(out_dir), figures, COMPARISON_FILE, page, summary_files(content))
+    beside = summary_files(content)
+    trials = comparison_data.trial_table(evaluated, a, b)
+    beside[comparison_data.FILE] = trials.to_csv(index=False).encode()
+    return write_page(Path(out_dir), figures, COMPARISON_FILE, page, beside)

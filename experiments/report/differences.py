@@ -4,7 +4,11 @@ makes, and the table and summary.json sections that show them.
 
 Each measure's parts are tested on one value per trial (experiments/analysis/trial_tests.py),
 paired over seeds where the sides hold the same seeds; a part a backend fixes by construction
-is shown without a test; pooled tests are second lines, never counted in the correction.
+is shown without a test; pooled tests are second lines, never counted in the correction. Beside
+every t, a nonparametric test of the same values (the Wilcoxon signed-rank test where the t is
+paired or against 0, the Mann-Whitney U test where the sides do not pair), with its own Holm
+adjustment over the same family (`FAMILY`); the cells whose star differs between the two are
+named (`disagreement_lines`).
 """
 
 from __future__ import annotations
@@ -33,22 +37,36 @@ from experiments.report.measures import GAP, NONE, Measure
 from experiments.report.pages import num, p_value, pct
 
 INTERACTION = "interaction"
+# The page's one family of tests, fixed by the registry and the sides' groups before any value
+# is compared: Holm's correction runs over all of it, once for the t and once for the
+# nonparametric p.
+FAMILY = (
+    "every part of every measure of the registry (experiments/report/measures.py) that both "
+    "sides recorded and that no backend fixes by construction: the sides' per-trial values "
+    "compared; for a gap measure, each side's gap against 0 and their interaction"
+)
 
 
 @dataclass(frozen=True)
 class Outcome:
     """One per-trial test of the page: a measure's part, a group's gap against 0 (`part` the
-    group) or the interaction of a gap measure; Holm-adjusted over the page's tests."""
+    group) or the interaction of a gap measure; its t's p and its nonparametric p
+    (`test.rank_p`) each Holm-adjusted over the page's tests."""
 
     measure: str
     part: str
     test: TrialTest
     groups: tuple[str, ...]
     holm_p: float = math.nan
+    rank_holm_p: float = math.nan
 
     @property
     def survives(self) -> bool:
         return survives(self.holm_p)
+
+    @property
+    def rank_survives(self) -> bool:
+        return survives(self.rank_holm_p)
 
 
 @dataclass(frozen=True)
@@ -118,8 +136,9 @@ def _evaluate(measure: Measure, a: BatchResults, b: BatchResults, paired: bool) 
 
 
 def evaluate(measures: tuple[Measure, ...], a: BatchResults, b: BatchResults) -> list[Evaluated]:
-    """Every measure both sides recorded something of, tested, with Holm's adjustment over
-    every outcome with a p. Paired over seeds where the sides hold the same seeds."""
+    """Every measure both sides recorded something of, tested, with Holm's adjustment of each
+    kind of p over every outcome with one. Paired over seeds where the sides hold the same
+    seeds."""
     paired = seeds_pair(list(a.trials["seed"]), list(b.trials["seed"]))
     evaluated = [_evaluate(m, a, b, paired) for m in measures]
     evaluated = [
@@ -127,10 +146,12 @@ def evaluate(measures: tuple[Measure, ...], a: BatchResults, b: BatchResults) ->
     ]
     outcomes = [o for e in evaluated for o in e.outcomes]
     adjusted = iter(holm([o.test.p for o in outcomes]))
-    return [
-        replace(e, outcomes=tuple(replace(o, holm_p=float(next(adjusted))) for o in e.outcomes))
-        for e in evaluated
-    ]
+    rank_adjusted = iter(holm([o.test.rank_p for o in outcomes]))
+
+    def adjust(o: Outcome) -> Outcome:
+        return replace(o, holm_p=float(next(adjusted)), rank_holm_p=float(next(rank_adjusted)))
+
+    return [replace(e, outcomes=tuple(adjust(o) for o in e.outcomes)) for e in evaluated]
 
 
 # Text ------------------------------------------------------------------------------------------
@@ -181,6 +202,20 @@ def holm_text(outcomes: tuple[Outcome, ...]) -> str:
     return _labelled(made, lambda o: "survives" if o.survives else "no") if made else ""
 
 
+def rank_holm_text(outcomes: tuple[Outcome, ...]) -> str:
+    """Which outcomes' nonparametric p survives Holm's correction."""
+    made = tuple(o for o in outcomes if np.isfinite(o.rank_holm_p))
+    return _labelled(made, lambda o: "survives" if o.rank_survives else "no") if made else ""
+
+
+def rank_cell(outcomes: tuple[Outcome, ...]) -> str:
+    """The nonparametric test beside the t of `outcomes` (one method for all), with its p."""
+    if not outcomes:
+        return ""
+    ps = _labelled(outcomes, lambda o: p_value(o.test.rank_p))
+    return f"{outcomes[0].test.rank_method}: {ps}"
+
+
 def outcome_p(outcome: Outcome) -> str:
     """An outcome's p, or why it has none."""
     test = outcome.test
@@ -226,6 +261,8 @@ def rows(evaluated: list[Evaluated], a: BatchResults, b: BatchResults) -> list[l
                     _method(within[:1]) + " per group",
                     _labelled(within, outcome_p),
                     holm_text(within),
+                    rank_cell(within),
+                    rank_holm_text(within),
                 ]
             )
             # The interaction: do the groups' per-trial values differ (the gaps, compared)?
@@ -239,12 +276,17 @@ def rows(evaluated: list[Evaluated], a: BatchResults, b: BatchResults) -> list[l
                     f"{_method(both)}; {groups[0]} − {groups[1]}: {difference}",
                     outcome_p(both[0]),
                     holm_text(both),
+                    rank_cell(both),
+                    rank_holm_text(both),
                 ]
             )
         else:
             test = ", ".join(x for x in (_method(within) if within else "", _untested_text(e)) if x)
             p = _labelled(within, outcome_p) if within else _ratio(e, groups)
-            out.append([m.label, *sides, test, p, holm_text(within)])
+            out.append(
+                [m.label, *sides, test, p, holm_text(within), rank_cell(within)]
+                + [rank_holm_text(within)]
+            )
         out += _pooled_rows(e, groups)
     return out
 
@@ -256,8 +298,8 @@ def _pooled_rows(e: Evaluated, groups: list[str]) -> list[list[str]]:
     label = f"└ the same, pooled over {what} (treats {what} as independent)"
     if len(e.pooled) == 2 and e.measure.test == GAP:  # one pooled test per group
         cells = [p_value(t.p) for t in e.pooled]
-        return [[label, *cells, f"{e.pooled[0].method}, per group", "", "not counted"]]
-    return [[label, "", "", t.method, p_value(t.p), "not counted"] for t in e.pooled]
+        return [[label, *cells, f"{e.pooled[0].method}, per group", "", "not counted", "", ""]]
+    return [[label, "", "", t.method, p_value(t.p), "not counted", "", ""] for t in e.pooled]
 
 
 # summary.json ----------------------------------------------------------------------------------
@@ -269,7 +311,8 @@ def _finite_or_none(x: float) -> float | None:
 
 def tests_summary(evaluated: list[Evaluated]) -> dict[str, Any]:
     """Every per-trial test (name, statistic, p, n per group, paired or not, Holm-adjusted p,
-    survives), the pooled second lines and the parts not tested, for summary.json."""
+    survives; the nonparametric test beside it: its name, p, Holm-adjusted p, survives), the
+    family, the pooled second lines and the parts not tested, for summary.json."""
     outcomes = [o for e in evaluated for o in e.outcomes]
     tests = [
         {
@@ -283,14 +326,20 @@ def tests_summary(evaluated: list[Evaluated]) -> dict[str, Any]:
             "paired": o.test.paired,
             "holm_p": _finite_or_none(o.holm_p),
             "survives": o.survives,
+            "rank_method": o.test.rank_method,
+            "rank_p": _finite_or_none(o.test.rank_p),
+            "rank_holm_p": _finite_or_none(o.rank_holm_p),
+            "rank_survives": o.rank_survives,
         }
         for o in outcomes
     ]
     return {
         "correction": "Holm",
         "alpha": ALPHA,
+        "family": FAMILY,
         "count": int(sum(np.isfinite(o.test.p) for o in outcomes)),
         "survive": int(sum(o.survives for o in outcomes)),
+        "survive_rank": int(sum(o.rank_survives for o in outcomes)),
         "tests": tests,
         "pooled": [
             {

@@ -26,13 +26,8 @@ from experiments import provenance, storage
 from experiments.analysis import step_split
 from experiments.analysis.results import ReportError, check_out_dir
 from experiments.report import ladder, ladder_data
-from experiments.report.ladder_page import (
-    cell_text,
-    completeness_lines,
-    json_records,
-    level_text,
-    rungs_table,
-)
+from experiments.report.ladder_page import completeness_lines, json_records, rungs_table
+from experiments.report.paired_text import cell_text, level_text
 
 FILES = ("factorial.csv", "factorial-trials.csv", "factorial.json", "factorial.md")
 # Each contrast: its name and its weights on the cells (neither, first, second, both).

@@ -23,6 +23,7 @@ from experiments.report import ladder, ladder_data, rung_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
 from experiments.report.pages import machines_text, p_value, seeds_text
+from experiments.report.paired_text import cell_text, level_text
 
 FILES = ("ladder.csv", ladder_data.FILE, "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}
@@ -30,42 +31,6 @@ WORLDS_TABLE_TITLE = (
     "Every rung's agents in each world (normalised competence, mean over the trials of the "
     "seeds every rung holds, trials in brackets):"
 )
-
-
-def signed_text(kind: str, x: float) -> str:
-    if not math.isfinite(x):
-        return "n/a"
-    return (
-        f"{100 * x:+.1f}"
-        if kind == "share"
-        else f"{x:+.3f}"
-        if kind == "distance"
-        else (f"{x:+.2f}" if kind == "ratio" else f"{x:+.1f}")
-    )
-
-
-def level_text(kind: str, x: float) -> str:
-    return signed_text(kind, x).lstrip("+")
-
-
-def _p_text(p: float, adjusted: float) -> str:
-    return p_value(p) + (" *" if survives(adjusted) else "")
-
-
-def cell_text(kind: str, row: dict) -> str:
-    """A difference as "+1.5 [-0.0, +3.0], p = 0.054; rank p = 0.061 (32)": the paired t's p,
-    then the signed-rank test's, each * where it survives Holm over the page's family."""
-    n = int(row["n"])
-    if not math.isfinite(row["mean"]):
-        return f"n/a ({n} pairs)"
-    low, high = signed_text(kind, row["low"]), signed_text(kind, row["high"])
-    text = f"{signed_text(kind, row['mean'])} [{low}, {high}]"
-    if not math.isfinite(row["p"]):
-        why = "fewer than 2 pairs" if n < 2 else "every pair equal"
-        return f"{text}, untested: {why} ({n})"
-    t = _p_text(row["p"], row["p_holm"])
-    rank = _p_text(row["p_rank"], row["p_rank_holm"]).replace("p ", "rank p ", 1)
-    return f"{text}, {t}; {rank} ({n})"
 
 
 def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[dict]:

@@ -23,8 +23,9 @@ from experiments.analysis.trial_tests import survives
 from experiments.report import rl_comparison as rl
 from experiments.report.figures import png_bytes
 from experiments.report.ladder import COMPETENCE
-from experiments.report.ladder_page import json_records, level_text, signed_text
+from experiments.report.ladder_page import json_records
 from experiments.report.pages import machines_text, p_value, seeds_text
+from experiments.report.paired_text import level_text, signed_text
 
 FILES = ("rl-compare.csv", "rl-compare.json", "rl-compare.png", "rl-compare.md")
 COLOURS = {rl.MODEL_BABBLING: "tab:blue", rl.SAC_HER: "tab:orange"}

@@ -105,3 +105,27 @@ def test_the_signed_rank_p_is_exact_on_few_pairs_and_none_where_every_pair_is_eq
     assert np.isnan(signed_rank_p(np.array([1.0])))
     # Ties (a measure of few values): the normal approximation, a p all the same.
     assert 0 < signed_rank_p(np.array([0.0, 0.0, 1, 1, 1, 2, 2, -1] * 4)) < 0.05
+
+
+def test_every_t_has_its_nonparametric_p_on_the_same_values_beside_it():
+    """Paired: the signed-rank test of the differences of the seeds both hold; unpaired: the
+    Mann-Whitney U test of all finite values (scipy's two-sided p); against 0: the signed-rank
+    test of the values; and none where the t has none."""
+    a = _by_seed([1.0, 2.0, 3.0, 5.0, 4.5, np.inf], [0, 1, 2, 3, 4, 5])
+    b = _by_seed([0.0, 2.5, 1.0, 1.0, 3.0, 9.0], [3, 2, 1, 0, 4, 9])
+    paired = difference_test(a, b, paired=True)
+    d = np.array([1.0, 2.0, 3.0, 5.0, 4.5]) - np.array([1.0, 1.0, 2.5, 0.0, 3.0])
+    assert paired.rank_method == "Wilcoxon signed-rank over seeds"
+    assert paired.rank_p == pytest.approx(stats.wilcoxon(d, zero_method="pratt").pvalue)
+    unpaired = difference_test(a, b, paired=False)
+    expected = stats.mannwhitneyu([1.0, 2.0, 3.0, 5.0, 4.5], [0.0, 2.5, 1.0, 1.0, 3.0, 9.0])
+    assert unpaired.rank_method == "Mann-Whitney U"
+    assert unpaired.rank_p == pytest.approx(expected.pvalue)
+    values = [0.1, 0.3, 0.2, -0.05, 0.4]
+    within = one_sample_test(_by_seed(values))
+    assert within.rank_method == "Wilcoxon signed-rank against 0"
+    assert within.rank_p == pytest.approx(stats.wilcoxon(values).pvalue)
+    same = difference_test(_by_seed([1.0, 2.0]), _by_seed([0.5, 1.5]), paired=True)
+    assert math.isnan(same.rank_p)
+    constant = difference_test(_by_seed([1.0, 1.0]), _by_seed([1.0, 1.0], [5, 6]), paired=False)
+    assert math.isnan(constant.p) and math.isnan(constant.rank_p)

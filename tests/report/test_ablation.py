@@ -116,8 +116,8 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
     )
     assert table.name == ABLATION_TABLE_FILE
     lines = table.read_text().splitlines()
-    assert len(lines) == 6 and "learner.exploration_sigma: 0.1 -> 0.05" in lines[3]
-    assert "survive Holm's correction" in lines[5]
+    assert "learner.exploration_sigma: 0.1 -> 0.05" in lines[3] and lines[4] == ""
+    assert "survives Holm's correction" in lines[5]
     csv = pd.read_csv(tmp_path / "out" / ABLATION_CSV_FILE)
     assert list(csv["n_trials"]) == [2, 2]
     columns = {"competence_all_difference", "competence_all_p", "competence_all_holm_p"}
@@ -134,6 +134,19 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
     assert p == pytest.approx(min(1, 2 * one_sided))
     assert "Mann-Whitney two-sided p, one-sided doubled as the study" in lines[0]
     assert (tmp_path / "out" / ABLATION_FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
+    # Every trial of every row, with who computed it (the trials' provenance.json, eval.json).
+    trials = pd.read_csv(tmp_path / "out" / "ablations-trials.csv")
+    assert list(zip(trials["batch"], trials["seed"], strict=True)) == [
+        ("kinematic", 0),
+        ("kinematic", 1),
+        ("sigma", 0),
+        ("sigma", 1),
+    ]
+    assert list(trials["baseline"]) == [True, True, False, False]
+    assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}(\+dirty)?").all()
+    assert trials["computed_on"].str.contains("from iteration 0").all()
+    assert trials["evaluated_on"].ne("not recorded").all()
+    assert list(trials["competence_all"][2:]) == [_competence(sigma_batch)[s] for s in (0, 1)]
 
 
 def test_batches_that_cannot_be_paired_are_refused_and_nothing_is_written(batches, tmp_path):

@@ -77,9 +77,10 @@ def test_the_per_trial_test_is_primary_where_the_pooled_one_would_be_tiny():
     i = _row(rows, CENTRE)
     assert rows[i][3] == "paired t over seeds (8 pairs)"
     assert f"tool p = {expected:.2g}" in rows[i][4] and "tool no" in rows[i][5]
-    label, *_, method, p, holm = rows[i + 1]
+    label, *_, method, p, holm, rank, rank_holm = rows[i + 1]
     assert label == "└ the same, pooled over tests (treats tests as independent)"
     assert method == "χ²" and p == f"p = {pooled.p:.1e}" and holm == "not counted"
+    assert rank == rank_holm == ""  # a pooled line has no test beside it either
     summary = differences.tests_summary(list(evaluated.values()))
     assert {t["measure"] for t in summary["pooled"]} >= {"strategies_project_study_centre"}
     assert summary["count"] == sum(1 for t in summary["tests"] if t["p"] is not None)

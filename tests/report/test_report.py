@@ -20,6 +20,7 @@ import pytest
 from old_trials import as_before_eval_checksums, as_before_manifests
 from page_checks import check_explained
 from summary_checks import check_summary
+from trial_recompute import check_trials_file
 
 from experiments import storage
 from experiments.analysis.curves import curve_rows, tool_numbers
@@ -154,6 +155,13 @@ def test_comparison_puts_both_backends_side_by_side(batches, tmp_path):
         ("physical", 0),
     ]
     assert per_trial["value"] == [t["competence_all"] for t in summary["trials"]]
+    # Beside each t, the Mann-Whitney U test (the sides do not pair), and where the two
+    # disagree on Holm's verdict; every trial's values beside the page (trial_recompute.py).
+    assert {t["rank_method"] for t in tests["tests"] if len(t["n"]) == 2} == {"Mann-Whitney U"}
+    assert "Where the t and the nonparametric test disagree on Holm's verdict" in text
+    trials = check_trials_file(out, text, tests["tests"])
+    pairs = zip(per_trial["group"], per_trial["seed"], strict=True)
+    assert list(zip(trials["group"], trials["seed"], strict=True)) == list(pairs)
 
 
 # Report numbers on hand-made tables ------------------------------------------------------------

@@ -29,16 +29,19 @@ def batch(
     pushed: Sequence[int] | None = None,
     words: Sequence[tuple[Sequence[float], Sequence[float]]] | None = None,
     pushes: bool = True,
+    grasp: str | None = None,
 ) -> BatchResults:
     """One group's trials, seed by seed: `competence` (competence_all), `tool_tests` (tool and
     hand tests near the centre, the study's rule), `pushed` (how many of the tool tests only
-    pushed the stick), `words` (best distances of the names, then of the distractors), and
-    whether its backend `pushes` (backend.json)."""
+    pushed the stick), `words` (best distances of the names, then of the distractors),
+    whether its backend `pushes` (backend.json), and its `grasp` backend (default: the group's
+    name)."""
     trials = pd.DataFrame(
         {
             "trial": [trial_name(group, s) for s in seeds],
             "group": group,
             "seed": list(seeds),
+            "grasp": grasp or group,
             "pushes": pushes,
             "closed_form": not pushes,
         }

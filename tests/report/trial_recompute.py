@@ -1,0 +1,93 @@
+"""A comparison page's tests computed again from its per-trial data alone (comparison-trials.csv),
+with scipy, as a reader would: for tests/report/test_comparison_data.py and the real page's
+test in tests/report/test_report.py."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from experiments.analysis.trial_tests import holm
+
+
+def _approx(x: float):
+    return pytest.approx(x, rel=1e-9, abs=1e-15)
+
+
+def _column(trials: pd.DataFrame, test: dict) -> str:
+    """A test's column: `measure:part` for a part of several, else the measure's one value."""
+    named = f"{test['measure']}:{test['part']}"
+    return named if named in trials.columns else test["measure"]
+
+
+def _by_seed(trials: pd.DataFrame, group: str, column: str) -> pd.Series:
+    return trials[trials["group"] == group].set_index("seed")[column].astype(float)
+
+
+def recomputed(trials: pd.DataFrame, test: dict) -> dict[str, float]:
+    """One test of summary.json's `trial_tests` (its measure, part, groups and pairing) from the
+    per-trial table: the difference (or mean), the t's p and the nonparametric p; NaN where
+    there is no test (fewer than two values a side, or no variance)."""
+    column, groups = _column(trials, test), list(test["n"])
+    if len(groups) == 1:  # a group's values against 0
+        x = _by_seed(trials, groups[0], column)
+        x = x[np.isfinite(x)].to_numpy()
+        if len(x) < 2 or np.all(x == x[0]):
+            return {"difference": x.mean(), "p": math.nan, "rank_p": math.nan}
+        rank = stats.wilcoxon(x, zero_method="pratt").pvalue
+        return {"difference": x.mean(), "p": stats.ttest_1samp(x, 0).pvalue, "rank_p": rank}
+    a, b = (_by_seed(trials, g, column) for g in groups)
+    if test["paired"]:
+        d = (a - b).dropna()
+        d = d[np.isfinite(d)].to_numpy()
+        if len(d) < 2 or np.all(d == d[0]):
+            return {"difference": d.mean(), "p": math.nan, "rank_p": math.nan}
+        rank = stats.wilcoxon(d, zero_method="pratt").pvalue
+        return {"difference": d.mean(), "p": stats.ttest_1samp(d, 0).pvalue, "rank_p": rank}
+    x, y = (s[np.isfinite(s)].to_numpy() for s in (a, b))
+    difference = x.mean() - y.mean()
+    if len(x) < 2 or len(y) < 2 or (np.var(x) == 0 and np.var(y) == 0):
+        return {"difference": difference, "p": math.nan, "rank_p": math.nan}
+    with warnings.catch_warnings():
+        # One side constant (every test held the stick): scipy warns of precision loss, as the
+        # page's Welch test does (experiments/analysis/stats.py welch); the p is still its.
+        warnings.simplefilter("ignore", RuntimeWarning)
+        p = stats.ttest_ind(x, y, equal_var=False).pvalue
+    rank = stats.mannwhitneyu(x, y, alternative="two-sided").pvalue
+    return {"difference": difference, "p": p, "rank_p": rank}
+
+
+def check_tests_again(trials: pd.DataFrame, tests: list[dict]) -> None:
+    """Every test of the page (summary.json's `trial_tests`' tests) and both Holm adjustments
+    over them, computed again from the per-trial table, are the page's."""
+    again = [recomputed(trials, t) for t in tests]
+    for kind, holm_kind in (("p", "holm_p"), ("rank_p", "rank_holm_p")):
+        adjusted = holm([a[kind] for a in again])
+        for test, a, h in zip(tests, again, adjusted, strict=True):
+            for value, expected in ((test[kind], a[kind]), (test[holm_kind], h)):
+                if math.isnan(expected):
+                    assert value is None or math.isnan(value), (test, kind)
+                else:
+                    assert value == _approx(expected), (test, kind)
+    for test, a in zip(tests, again, strict=True):
+        if test["difference"] is not None:
+            assert test["difference"] == _approx(a["difference"]), test
+
+
+def check_trials_file(out: Path, page: str, tests: list[dict]) -> pd.DataFrame:
+    """comparison-trials.csv beside a comparison page written into `out` (`page` its HTML,
+    `tests` its summary.json's tests): linked from the page, who learned and evaluated each
+    trial recorded, and every test of the page computed again from it. Returns the table."""
+    assert 'href="comparison-trials.csv"' in page
+    trials = pd.read_csv(out / "comparison-trials.csv")
+    assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}(\+dirty)?").all()
+    assert trials["computed_on"].str.contains("from iteration 0").all()
+    assert trials["evaluated_on"].ne("not recorded").all()
+    check_tests_again(trials, tests)
+    return trials
