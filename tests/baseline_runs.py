@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from experiments import storage
 from experiments.baseline.settings import BaselineSettings, run_name, summary_config, trial_config
-from experiments.file_names import BASELINE_FILE
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
 from experiments.measure.trial_evaluation import evaluation_files, measured
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import BASELINE_FILE
 
 
 class RestingPolicy:

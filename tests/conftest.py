@@ -71,12 +71,12 @@ def batches(tmp_path_factory):
     """Two tiny batches, one per grasp backend: kinematic seeds 0 and 1, physical seed 0
     (300 iterations, evaluated on 3 placements), each with the record (batch.json) that
     `playroom batch` writes. Tests only read them."""
-    from experiments import storage
+    from experiments.batch_files import BATCH_FILE
     from experiments.batches.spec import BatchSpec, spec_record
-    from experiments.file_names import BATCH_FILE
     from experiments.measure.evaluation import EvaluationSettings
     from experiments.measure.trial_evaluation import evaluate_trial
     from experiments.run.trial import run_trial
+    from experiments.trial_dir import storage
 
     root = tmp_path_factory.mktemp("batches")
     out = {}

@@ -7,15 +7,15 @@ import shutil
 from collections.abc import Callable
 from pathlib import Path
 
-from experiments import eval_record, storage
-from experiments.file_names import (
+from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     EVAL_FILE,
     MANIFEST_DIR,
     PREVIOUS_CHECKPOINT_FILE,
     VOCAL_FILE,
 )
-from experiments.manifest import EVAL_FILES_KEY, MANIFEST_KEY
+from experiments.trial_dir.manifest import EVAL_FILES_KEY, MANIFEST_KEY
 
 # What checkpoints recorded of their directory since manifests.
 _SINCE_MANIFESTS = (MANIFEST_KEY, "trial_name")

@@ -12,7 +12,7 @@ against logs recorded on one with AVX-512:
   its events are not: contacts amplify the last bits of NumPy's and OpenBLAS's kernels (the
   trial of another OpenBLAS kernel differed in 48 rows from iteration 1901 on). Its event
   counts are compared within the spread of other seeds, and its logs bit for bit only on a
-  machine whose record (experiments/provenance.py) is the recording's.
+  machine whose record (experiments/trial_dir/provenance.py) is the recording's.
 
 Run from the checkout, after a change meant to alter behaviour (say so in the commit):
     .venv/bin/python tests/reference_trials.py logs     # the two trials' logs, and this machine
@@ -73,7 +73,7 @@ def run_logs(grasp: str, out: Path, seed: int = SEED) -> dict[str, pd.DataFrame]
 def machine_differences(grasp: str) -> list[str]:
     """What differs between this machine and the one that recorded a trial's logs, in what can
     change its bits (the commit aside: the logs are what the code must keep giving)."""
-    from experiments.provenance import bit_differences, machine_record
+    from experiments.trial_dir.provenance import bit_differences, machine_record
 
     path = machine_path(grasp)
     if not path.exists():
@@ -95,7 +95,7 @@ def event_counts(log: pd.DataFrame) -> dict[str, int]:
 
 
 def record_logs(grasps: tuple[str, ...] = GRASPS) -> None:
-    from experiments.provenance import machine_record
+    from experiments.trial_dir.provenance import machine_record
 
     with tempfile.TemporaryDirectory() as tmp:
         for grasp in grasps:
@@ -108,7 +108,7 @@ def record_logs(grasps: tuple[str, ...] = GRASPS) -> None:
 
 
 def record_spread() -> None:
-    from experiments.provenance import machine_record
+    from experiments.trial_dir.provenance import machine_record
 
     counts = {}
     with tempfile.TemporaryDirectory() as tmp:

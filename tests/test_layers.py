@@ -11,7 +11,7 @@ import pytest
 
 SIMULATOR = ("mujoco", "dm_control", "numba", "sim", "learner")
 # What a reader of trials loads of sim: the plain settings dataclasses, whose fields declare
-# what older trials ran with (experiments/config_file.py), and the package's face (its GL
+# what older trials ran with (experiments/trial_dir/config_file.py), and the package's face (its GL
 # library check and environment guard, plain Python); no room, no tract.
 SIM_SETTINGS = (
     "sim",
@@ -30,9 +30,12 @@ SIM_SETTINGS = (
         ("import experiments.analysis.stats", SIMULATOR),
         ("import experiments.report.comparison", SIMULATOR),
         ("from experiments.analysis.logs import read_log, read_batch_logs", SIMULATOR),
-        # The log layout and schema, the backend record: the writer's and readers' shared files.
+        # The trial directory's package, whole: its layout, schema, records, checks and
+        # checkpoint restore (into an agent and room the run's stage builds).
         (
-            "import experiments.log_layout, experiments.log_schema, experiments.backend_record",
+            "import experiments.trial_dir.layout, experiments.trial_dir.log_schema, "
+            "experiments.trial_dir.backend_record, experiments.trial_dir.checks, "
+            "experiments.trial_dir.opening",
             SIMULATOR,
         ),
         # Naming and checking the grasp backends imports none of them.
@@ -43,7 +46,7 @@ SIM_SETTINGS = (
             ("mujoco", "dm_control", "numba"),
         ),
         (
-            "from experiments.provenance import machine_record; machine_record()",
+            "from experiments.trial_dir.provenance import machine_record; machine_record()",
             ("mujoco", "dm_control", "pandas"),
         ),
     ],

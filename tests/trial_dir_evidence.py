@@ -173,7 +173,7 @@ def _readers() -> dict:
     from experiments.measure.trial_evaluation import evaluate_trial
 
     load_trial = _function(
-        ("experiments.trial_dir.checkpoint", "experiments.run.trial_checks"), "load_trial"
+        ("experiments.run.trial_parts", "experiments.run.trial_checks"), "load_trial"
     )
     settings = EvaluationSettings(n_placements=PLACEMENTS)
     return {

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import eval_record, storage
 from experiments.analysis.batch_checks import shared_config
 from experiments.analysis.results import (
     BatchResults,
@@ -24,14 +23,15 @@ from experiments.analysis.results import (
     _evaluation_table,
     _read_json,
 )
-from experiments.file_names import (
+from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir.layout import (
     BASELINE_FILE,
     COMPETENCE_FILE,
     EVAL_FILE,
     STUDY_TESTS_FILE,
     VOCAL_FILE,
 )
-from experiments.provenance import SHORT_FIELDS, short_record
+from experiments.trial_dir.provenance import SHORT_FIELDS, short_record
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ def is_baseline_dir(directory: Path) -> bool:
 
 def _summary(run_dir: Path, config: dict) -> dict:
     """A run's eval.json, checked against itself and the trial config its baseline.json
-    records (experiments/eval_record.py); ReportError (one line) otherwise."""
+    records (experiments/trial_dir/eval_record.py); ReportError (one line) otherwise."""
     remedy = (
         f"remove it and run the same `playroom rl-baseline` command into {run_dir} again "
         "(its trained policies are kept)"

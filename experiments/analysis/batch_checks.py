@@ -9,8 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from experiments import storage
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
+from experiments.trial_dir import storage
 
 
 class BatchMismatch(ValueError):

@@ -10,10 +10,10 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from experiments import eval_record, storage
-from experiments.config_file import with_added_settings
-from experiments.file_names import BATCH_FILE, CONFIG_FILE, MANIFEST_DIR
-from experiments.log_layout import is_trial_dir
+from experiments.batch_files import BATCH_FILE
+from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE, MANIFEST_DIR, is_trial_dir
 
 
 class RecordMismatch(ValueError):
@@ -63,10 +63,10 @@ def recorded_reference_commands(batch_dirs: Iterable[str | os.PathLike]) -> int 
 
 def check_not_lost(batch_dir: Path) -> None:
     """RecordMismatch (one line, saying how to write it again) for a batch directory without
-    batch.json whose trials record a manifest (experiments/manifest.py): every version that
-    wrote manifests wrote batch.json too, so its record was lost (or the folder was put
-    together by hand), and the reference size its profile set is unknown; only a batch from
-    before records is reported at the study's size without one."""
+    batch.json whose trials record a manifest (experiments/trial_dir/manifest.py): every version
+    that wrote manifests wrote batch.json too, so its record was lost (or the folder was put
+    together by hand), and the reference size its profile set is unknown; only a batch from before
+    records is reported at the study's size without one."""
     if (batch_dir / BATCH_FILE).exists() or not batch_dir.is_dir():
         return
     for trial_dir in sorted(batch_dir.iterdir()):
@@ -117,8 +117,8 @@ def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path])
     directory with other settings, before `playroom batch` refused it, left such a mix. A
     batch without a record is not checked (one written before batch.json, or a folder of
     trials run one by one); a record that cannot be read is refused (`read_batch_record`).
-    Each eval.json is read checked (experiments/eval_record.py): one that is not as recorded
-    is left to the reader that needs it to name, not taken for another batch's."""
+    Each eval.json is read checked (experiments/trial_dir/eval_record.py): one that is not as
+    recorded is left to the reader that needs it to name, not taken for another batch's."""
     path = Path(batch_dir) / BATCH_FILE
     record = read_batch_record(batch_dir)
     if record is None:

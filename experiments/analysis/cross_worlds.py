@@ -5,10 +5,10 @@ final agent, so that a difference between two conditions splits into what the ag
 worlds).
 
 A trial's test in a world is its evaluation in that eval world (`DIR/eval-in-WORLD/eval.json`,
-`playroom eval DIR --world WORLD`, experiments/eval_worlds.py) or, where that world is the
+`playroom eval DIR --world WORLD`, experiments/trial_dir/eval_worlds.py) or, where that world is the
 trial's own (`eval_worlds.own_world`), its own evaluation (eval.json).
 Each evaluation's eval.json is checked against its own checksum and the trial's config.json
-(experiments/eval_record.py), its tables against the sizes and SHA-256 it lists.
+(experiments/trial_dir/eval_record.py), its tables against the sizes and SHA-256 it lists.
 """
 
 from __future__ import annotations
@@ -18,16 +18,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import eval_record, manifest, storage
 from experiments.analysis.logs import trial_dirs
-from experiments.config_file import with_added_settings
-from experiments.eval_worlds import own_world
-from experiments.file_names import (
-    CONFIG_FILE,
-    EVAL_FILE,
-    EVALUATION_TABLES,
-    eval_world_dir,
-)
+from experiments.trial_dir import eval_record, manifest, storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.eval_worlds import own_world
+from experiments.trial_dir.layout import CONFIG_FILE, EVAL_FILE, EVALUATION_TABLES, eval_world_dir
 
 RINGS = ("ring1", "ring2", "ring3")
 STRATEGIES = ("hand", "tool", "vocal")

@@ -7,7 +7,7 @@ iterations each), in a long table (iteration, metric, value):
 - word_recognised: share of vocal movements in which the caregiver recognised a word;
 - stick_in_reach: share of iterations that began with the stick's handle within the study's
   reach (arm length plus the world's grasp distance: one yardstick for every backend,
-  experiments/backend_record.py `study_reach`); stick_returned: share of iterations after
+  experiments/trial_dir/backend_record.py `study_reach`); stick_returned: share of iterations after
   which the experimenter returned the stick (a trial written before these columns existed
   recorded neither: it has no such curves, and its stick numbers are NaN);
 - best_distance_names, best_distance_distractors: mean best distance so far of the trial's
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from experiments.log_schema import (
+from experiments.trial_dir.log_schema import (
     ITERATION,
     MOTOR_SPACE,
     STICK_DISTANCE,

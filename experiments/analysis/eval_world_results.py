@@ -1,12 +1,12 @@
 """A batch's final agents as tested in one eval world, read into tables.
 
 `collect(batch_dir, world)` is `experiments.analysis.results.collect` reading each trial's
-evaluation in eval world `world` (experiments/eval_worlds.py) instead of its own: the same
+evaluation in eval world `world` (experiments/trial_dir/eval_worlds.py) instead of its own: the same
 `BatchResults` (competence per test and per trial, all rings and ring by ring, strategies,
 words, the study's tests), so that agents of both backends can be compared in one test world.
 A trial whose own world that is reads its own evaluation (eval.json in the trial directory);
 the others read `eval-in-<world>/`, refused in one line (ReportError) when missing, damaged
-(an eval.json not as it recorded itself or of another trial, experiments/eval_record.py; a
+(an eval.json not as it recorded itself or of another trial, experiments/trial_dir/eval_record.py; a
 table whose size or checksum is not what its eval.json lists), or made for another world
 than the one declared now; the message names the command that makes it. The trials' rows say
 where they were tested (`eval_world`, `tested_grasp`, `tested_in_own_world`).
@@ -19,11 +19,11 @@ import json
 import os
 from pathlib import Path
 
-from experiments import eval_record, manifest, storage
 from experiments.analysis.results import BatchResults, ReportError
 from experiments.analysis.results import collect as collect_own
-from experiments.config_file import with_added_settings
-from experiments.eval_worlds import (
+from experiments.trial_dir import eval_record, manifest, storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.eval_worlds import (
     EVAL_WORLDS,
     OWN,
     SWITCHES,
@@ -31,8 +31,13 @@ from experiments.eval_worlds import (
     own_world,
     world_record,
 )
-from experiments.file_names import CONFIG_FILE, EVAL_FILE, EVALUATION_TABLES, eval_world_dir
-from experiments.log_layout import is_trial_dir
+from experiments.trial_dir.layout import (
+    CONFIG_FILE,
+    EVAL_FILE,
+    EVALUATION_TABLES,
+    eval_world_dir,
+    is_trial_dir,
+)
 
 # Trials named in a refusal; more are counted.
 NAMED = 3
@@ -40,7 +45,7 @@ NAMED = 3
 
 class EvalWorldMismatch(storage.CorruptFileError):
     """An evaluation folder of a trial made for another eval world, or as another declaration
-    of it than the one in experiments/eval_worlds.py now (one line)."""
+    of it than the one in experiments/trial_dir/eval_worlds.py now (one line)."""
 
 
 def remedy(trial_dir: Path, world: str) -> str:
@@ -64,13 +69,13 @@ def check_evaluation(trial_dir: Path, config: dict, world: str, summary: dict) -
     folder = Path(trial_dir) / eval_world_dir(world)
     how = remedy(trial_dir, world)
     # What makes the world: a world setting added to the project later (and filled in for
-    # older files, experiments/config_file.py) does not make an evaluation stale.
+    # older files, experiments/trial_dir/config_file.py) does not make an evaluation stale.
     expected = json.loads(json.dumps(_identity(world_record(config, world))))
     recorded = summary.get("eval_world")
     if not isinstance(recorded, dict) or _identity(recorded) != expected:
         raise EvalWorldMismatch(
             f"{folder / EVAL_FILE} is not an evaluation in the {world} world as declared now "
-            f"(experiments/eval_worlds.py): {how}"
+            f"(experiments/trial_dir/eval_worlds.py): {how}"
         )
     listed = summary.get(manifest.EVAL_FILES_KEY)
     for name in EVALUATION_TABLES:

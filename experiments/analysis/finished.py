@@ -12,8 +12,8 @@ import os
 import warnings
 from pathlib import Path
 
-from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE
 
 # Trials named in a warning; more are counted.
 NAMED = 5

@@ -4,14 +4,14 @@
     log = read_log("runs/demo/kinematic-random-seed0000")            # one row per iteration
     words = read_batch_logs("runs/demo", kind="words")               # every trial of a batch
 
-What the logs hold, column by column: experiments/log_schema.py; where their chunks lie:
-experiments/log_layout.py; the writer (experiments/run/) writes by both. A trial written before
-a column existed reads it as the schema declares (missing, for what it did not record). Every
-row carries its source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials
-keep apart; every chunk its trial's identity, so that a chunk copied from another trial is
-refused. Each kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`),
-so `pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its
-chunks' names, which is the iterations' order).
+What the logs hold, column by column: experiments/trial_dir/log_schema.py; where their chunks lie:
+experiments/trial_dir/layout.py; the writer (experiments/run/) writes by both. A trial written
+before a column existed reads it as the schema declares (missing, for what it did not record). Every
+row carries its source (`trial`, `seed`, `backend`, `voice`), so that rows of several trials keep
+apart; every chunk its trial's identity, so that a chunk copied from another trial is refused. Each
+kind also lies in its own folder (`TRIAL/log/iterations/`, `TRIAL/log/words/`), so
+`pd.read_parquet("TRIAL/log/iterations")` reads exactly one kind (in the order of its chunks' names,
+which is the iterations' order).
 """
 
 from __future__ import annotations
@@ -22,12 +22,17 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import manifest, storage
 from experiments.analysis.batch_checks import check_batch
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
-from experiments.config_file import UnknownSettingError, check_known, with_added_settings
-from experiments.file_names import CONFIG_FILE
-from experiments.log_layout import (
+from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.config_file import (
+    UnknownSettingError,
+    check_known,
+    trial_identity,
+    with_added_settings,
+)
+from experiments.trial_dir.layout import (
+    CONFIG_FILE,
     LOST_CHUNK_REMEDY,
     check_chunk,
     check_kind,
@@ -36,9 +41,8 @@ from experiments.log_layout import (
     is_trial_dir,
     kind_dir,
     source_of,
-    trial_identity,
 )
-from experiments.log_schema import SOURCE_COLUMNS, upgraded
+from experiments.trial_dir.log_schema import SOURCE_COLUMNS, upgraded
 
 
 def read_log(
@@ -49,11 +53,11 @@ def read_log(
     before rows carried them). An empty DataFrame if the trial has no chunk of that kind yet.
     `columns`: only those (of them, the ones the log has or the schema declares) beside the
     source columns; a log's 47 columns take twice as long to read as the report's 10. Columns
-    the trial's chunks lack are added as experiments/log_schema.py declares (`upgraded`:
+    the trial's chunks lack are added as experiments/trial_dir/log_schema.py declares (`upgraded`:
     missing, where the trial did not record them).
 
     Every chunk is checked before it is read: against the manifest of the trial's newest
-    checkpoint (experiments/manifest.py: missing, damaged, replaced or stray chunks are a
+    checkpoint (experiments/trial_dir/manifest.py: missing, damaged, replaced or stray chunks are a
     manifest.DamagedFileError naming the chunk), and by the identity it carries (a chunk of
     another trial is a ForeignChunkError); both are storage.CorruptFileError, one line. A
     chunk past the newest checkpoint is a running trial's work in progress, not yet vouched

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from experiments.log_schema import (
+from experiments.trial_dir.log_schema import (
     CAREGIVER_SAID,
     GOAL_COLUMNS,
     ITERATION,

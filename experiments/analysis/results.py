@@ -22,17 +22,17 @@ from typing import Any
 
 import pandas as pd
 
-from experiments import backend_record, eval_record, manifest, storage
 from experiments.analysis.batch_checks import BatchMismatch, check_group, group_label, shared_config
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
 from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
-from experiments.backend_record import CAPABILITIES
-from experiments.config_file import with_added_settings
-from experiments.eval_record import SCENES_KEY
-from experiments.file_names import (
+from experiments.trial_dir import backend_record, eval_record, manifest, storage
+from experiments.trial_dir.backend_record import CAPABILITIES
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.eval_record import SCENES_KEY
+from experiments.trial_dir.layout import (
     COMPETENCE_FILE,
     CONFIG_FILE,
     EVAL_FILE,
@@ -40,10 +40,11 @@ from experiments.file_names import (
     STUDY_TESTS_FILE,
     TIMING_FILE,
     VOCAL_FILE,
+    is_trial_dir,
 )
-from experiments.log_layout import is_trial_dir
-from experiments.log_schema import DIVERGED
-from experiments.provenance import SHORT_FIELDS, computed_on
+from experiments.trial_dir.log_schema import DIVERGED
+from experiments.trial_dir.provenance import SHORT_FIELDS
+from experiments.trial_dir.provenance_file import computed_on
 
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
 
@@ -143,8 +144,9 @@ def _read_json(path: Path) -> Any:
 
 def read_summary(trial_dir: Path, config: dict, folder: Path | None = None) -> dict:
     """The eval.json of a trial's evaluation in `folder` (default: its own, in the trial
-    directory), checked against itself and the trial's `config` (experiments/eval_record.py);
-    ReportError (one line naming the file and what to do) otherwise."""
+    directory), checked against itself and the trial's `config`
+    (experiments/trial_dir/eval_record.py); ReportError (one line naming the file and what to do)
+    otherwise."""
     folder = trial_dir if folder is None else folder
     remedy = eval_record.evaluation_remedy(trial_dir, folder)
     try:
@@ -283,8 +285,8 @@ def _timing(trial_dir: Path) -> tuple[float, float]:
 
 
 def _backend(trial_dir: Path, config: dict) -> dict[str, Any]:
-    """What the trial's backend declared (experiments/backend_record.py; older trials: from
-    their config): its `reach` (m) and capabilities, what it cannot do by construction."""
+    """What the trial's backend declared (experiments/trial_dir/backend_record.py; older trials:
+    from their config): its `reach` (m) and capabilities, what it cannot do by construction."""
     try:
         record = backend_record.read_record(trial_dir, config)
     except (storage.CorruptFileError, ValueError) as exc:

@@ -23,13 +23,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import storage
 from experiments.analysis import step_split
 from experiments.analysis.cross_worlds import RINGS, STRATEGIES, checked_summary, tested_in
 from experiments.analysis.logs import trial_dirs
 from experiments.analysis.trial_tests import ALPHA, survives
-from experiments.config_file import with_added_settings
-from experiments.file_names import CONFIG_FILE
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE
 
 OWN = "own"
 MEASURES = ("competence_all", "competence_ring1", "competence_ring2", "competence_ring3")
@@ -47,8 +47,8 @@ def _numbers(summary: dict) -> dict[str, float]:
 def evaluations(conditions: dict[str, Path], check: bool = True) -> pd.DataFrame:
     """One row per (condition, seed, tested): `tested` is "own" (the trial's own evaluation) or
     a test world it was tested in (its cross-evaluation, or its own where it learned there).
-    Each evaluation's eval.json is checked (experiments/eval_record.py), and its tables against
-    it unless not `check` (copies of eval.json without their tables, said on the command
+    Each evaluation's eval.json is checked (experiments/trial_dir/eval_record.py), and its tables
+    against it unless not `check` (copies of eval.json without their tables, said on the command
     line)."""
     rows = []
     for condition, batch_dir in conditions.items():

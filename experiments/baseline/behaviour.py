@@ -15,12 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import storage
 from experiments.baseline import training
 from experiments.baseline.run import policy_file, trained_toys
 from experiments.baseline.settings import BaselineError
-from experiments.file_names import BASELINE_FILE
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import BASELINE_FILE
 from sim.config import config_from_dict
 from sim.vocal.config import VoiceConfig
 

@@ -28,7 +28,6 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import provenance, storage
 from experiments.baseline import control_learner as cl
 from experiments.baseline.control_settings import (
     CONTROL,
@@ -43,7 +42,8 @@ from experiments.baseline.control_settings import (
     library_defaults,
 )
 from experiments.baseline.training import library_versions, rl_library
-from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from sim.envs.versions import GOAL_VARIANTS
 
 CONTROL_FILE = "control.json"

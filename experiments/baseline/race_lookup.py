@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments import storage
 from experiments.baseline import race_learners as rl
 from experiments.baseline.race_claims import paired_p
 from experiments.baseline.race_run import ALL_RINGS, TRIALS
 from experiments.baseline.race_settings import FIRST_HELD_OUT_SEED, RaceError
+from experiments.trial_dir import storage
 from learner.agent import Agent
 from models.layout import CONTEXT_DIM, N_SAMPLES
 from sim.envs.gym_env import ACTION_DIM, ARM_PART, SELECTOR, SPACE_DTYPE
@@ -88,7 +88,7 @@ def race_lookup(race_dir: str | Path) -> pd.DataFrame:
     import gymnasium
 
     import sim.envs  # noqa: F401  (registers the ids)
-    from experiments.run.trial_checks import load_trial
+    from experiments.run.trial_parts import load_trial
 
     race = Path(race_dir)
     if not (race / "race.json").is_file():

@@ -30,7 +30,6 @@ from typing import Any
 
 import pandas as pd
 
-from experiments import provenance, storage
 from experiments.baseline import control_learner as cl
 from experiments.baseline import race_learners as rl
 from experiments.baseline.control_run import opened_record
@@ -49,8 +48,9 @@ from experiments.baseline.race_settings import (
     RaceRun,
 )
 from experiments.baseline.training import library_versions, rl_library
-from experiments.file_names import CONFIG_FILE
-from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 
 RACE_FILE = "race.json"
 RUNS, TRIALS = "runs", "trials"
@@ -121,7 +121,7 @@ def run_random(run: RaceRun) -> tuple[list[dict[str, Any]], float]:
 def run_model_babbling(run: RaceRun, trial_dir: Path) -> tuple[list[dict[str, Any]], float]:
     """Model Babbling's curve (the module's docstring), and the seconds its tests took."""
     from experiments.run.trial import run_trial
-    from experiments.run.trial_checks import load_trial
+    from experiments.run.trial_parts import load_trial
 
     test_env = _env(run, motor="both")
     tests = trial_dir.with_name(f"{trial_dir.name}-tests")

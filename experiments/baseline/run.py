@@ -23,7 +23,6 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from experiments import manifest, provenance, storage
 from experiments.baseline import training
 from experiments.baseline.settings import (
     ALGORITHM,
@@ -34,12 +33,13 @@ from experiments.baseline.settings import (
     summary_config,
     trial_config,
 )
-from experiments.file_names import BASELINE_FILE, EVAL_FILE, TRAINING_FILE
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
 from experiments.measure.trial_evaluation import evaluation_files, measured
-from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import manifest, provenance, storage
+from experiments.trial_dir.layout import BASELINE_FILE, EVAL_FILE, TRAINING_FILE
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from sim.config import config_from_dict
 from sim.vocal.config import VoiceConfig
 

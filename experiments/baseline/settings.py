@@ -74,7 +74,7 @@ class BaselineSettings:
                 raise BaselineError(f"{name} must be at most {high}, got {value!r}")
         # Here, not at the module's top: the command line's parser reads this module's numbers
         # and must load no simulator (experiments/cli/main.py).
-        from experiments.run.trial_files import TrialError
+        from experiments.trial_dir.errors import TrialError
 
         try:
             self.trial()  # grasp, seed, preset, voice and overrides, as `playroom run` checks
@@ -116,7 +116,7 @@ def trial_config(settings: BaselineSettings) -> dict:
     learner settings the baseline's room is built from. BaselineError for settings that make
     none (a DIVA voice whose data is not installed)."""
     from experiments.run.trial_config import full_config
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir.errors import TrialError
 
     try:
         return full_config(settings.trial())

@@ -13,12 +13,12 @@ import dataclasses
 import json
 from pathlib import Path
 
-from experiments import eval_record, storage
+from experiments.batch_files import BATCH_FILE
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
-from experiments.config_file import with_added_settings
-from experiments.file_names import BATCH_FILE, CONFIG_FILE
-from experiments.log_layout import is_trial_dir
 from experiments.run.trial_config import full_config
+from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE, is_trial_dir
 
 # Fields compared as sets: their order changes only the order trials are listed in.
 _SETS = ("grasps", "babbling", "seeds")
@@ -26,7 +26,7 @@ _SETS = ("grasps", "babbling", "seeds")
 # (the trials stay what they are; each world's evaluation is derived from them, beside them).
 _FREE = ("description", "eval_worlds")
 # Config keys a trial may hold otherwise and still be the batch's: the release that wrote it
-# (a checkpoint's identity leaves it out too: experiments/run/trial_files.py).
+# (a checkpoint's identity leaves it out too: experiments/trial_dir/config_file.py).
 _NOT_SETTINGS = ("package_version",)
 # Trials named in a refusal; more are counted.
 NAMED = 3

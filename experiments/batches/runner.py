@@ -4,7 +4,7 @@ Without a scheduler address the batch runs on a `LocalCluster` of worker process
 machine; with one (`tcp://HOST:PORT`) the same batch runs on an existing cluster, e.g. workers
 started on PBS or SLURM nodes by dask-jobqueue (README). Each trial is one Dask task that runs
 (or resumes) the trial and evaluates it, in its own world and in the batch's eval worlds
-(experiments/eval_worlds.py), so:
+(experiments/trial_dir/eval_worlds.py), so:
 - rerunning a batch skips evaluated trials and resumes unfinished ones from their checkpoints;
   a trial whose evaluations in the eval worlds are not all complete and intact has only those
   made;
@@ -29,8 +29,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from experiments import eval_record, manifest, storage
 from experiments.analysis.eval_world_results import check_evaluation
+from experiments.batch_files import BATCH_FILE
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches import worker_check, workers
 from experiments.batches.cluster_settings import RETRIES, WORKER_WAIT_S
@@ -43,24 +43,25 @@ from experiments.batches.progress import (
     reporter,
 )
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
-from experiments.config_file import with_added_settings
-from experiments.eval_worlds import EvalWorldError, own_world
-from experiments.file_names import (
-    BATCH_FILE,
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run import estimate
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.trial_dir import eval_record, manifest, memory_segments, storage
+from experiments.trial_dir.checkpoint import check_identity
+from experiments.trial_dir.checks import check_files
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.eval_worlds import EvalWorldError, own_world
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     EVALUATION_TABLES,
     TIMING_FILE,
     eval_world_dir,
 )
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run import estimate, memory_segments
-from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_checks import check_files, check_identity
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 
 # How long a batch task waits for another writer of its trial to finish (s): longer than a

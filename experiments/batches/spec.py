@@ -13,13 +13,13 @@ from importlib import resources
 from pathlib import Path
 from typing import TypeGuard
 
-from experiments import storage
 from experiments.analysis.study_summary import RANDOM_COMMANDS_PER_RING
 from experiments.batches.stored import stored_profiles
-from experiments.eval_worlds import EVAL_WORLDS
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir import storage
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.eval_worlds import EVAL_WORLDS
 from learner.config import BABBLING_MODES, LearnerConfig
 from models.checks import MAX_SEED
 from models.presets import DEFAULT_PRESET, PRESETS
@@ -52,7 +52,7 @@ FIELD_RULES = {
     "eval_placements": "a positive integer (placements per ring)",
     "eval_worlds": (
         f"a list of distinct eval worlds from {', '.join(EVAL_WORLDS)} (each trial's final agent "
-        "is also tested there; experiments/eval_worlds.py)"
+        "is also tested there; experiments/trial_dir/eval_worlds.py)"
     ),
     "stick_return": f"one of {', '.join(STICK_RETURNS)}",
     "preset": f"one of {', '.join(PRESETS)}",
@@ -85,8 +85,8 @@ class BatchSpec:
     iterations: int = 1000
     checkpoint_every: int = 1000
     eval_placements: int = 100
-    # Eval worlds (experiments/eval_worlds.py) each trial's final agent is tested in besides
-    # its own, written into eval-in-NAME/ of the trial (one equal to its own is its own).
+    # Eval worlds (experiments/trial_dir/eval_worlds.py) each trial's final agent is tested in
+    # besides its own, written into eval-in-NAME/ of the trial (one equal to its own is its own).
     eval_worlds: tuple[str, ...] = ()
     stick_return: str = WorldConfig.stick_return
     preset: str = DEFAULT_PRESET

@@ -73,12 +73,12 @@ def _version_differences(expected: dict, found: dict) -> list[str]:
 def worker_problem(expected: dict[str, Any]) -> str | None:
     """Why this worker may not run a trial of the batch `expected` describes, in one line
     naming the worker and what to do; None when it may. `expected`: {"code": the submitter's
-    `experiments.provenance.machine_record()`'s "source" and the "versions" to
+    `experiments.trial_dir.provenance.machine_record()`'s "source" and the "versions" to
     compare, "token_path": a file in the batch directory,
     "token": its content}."""
     name = _worker_name()
     try:
-        provenance = importlib.import_module("experiments.provenance")
+        provenance = importlib.import_module("experiments.trial_dir.provenance")
         # machine_record, which every version of the project since provenance has: an older
         # copy is told as another version, not as one that cannot be imported.
         found = provenance.machine_record()

@@ -21,11 +21,11 @@ from pathlib import Path
 
 import cloudpickle  # type: ignore[import-untyped]
 
-from experiments import provenance
+from experiments.batch_files import WORKER_TOKEN_FILE
 from experiments.batches import worker_check
 from experiments.batches.cluster_settings import NO_WORKER_NOTICE_S, WORKER_COUNT_EVERY_S
 from experiments.batches.spec import BatchError
-from experiments.file_names import WORKER_TOKEN_FILE
+from experiments.trial_dir import provenance
 
 # Sent by value: the check must run on a worker that cannot import the project.
 cloudpickle.register_pickle_by_value(worker_check)
@@ -33,7 +33,7 @@ cloudpickle.register_pickle_by_value(worker_check)
 
 def code_expected() -> dict:
     """What every worker's code must be: the submitter's commit and its versions of Python and
-    of the libraries that change a trial's bits (experiments/provenance.py COMPUTING)."""
+    of the libraries that change a trial's bits (experiments/trial_dir/provenance.py COMPUTING)."""
     record = provenance.machine_record()
     versions = record["versions"]
     names = ("python", *provenance.COMPUTING)

@@ -56,7 +56,7 @@ def has_avx512(cpuinfo: str = "/proc/cpuinfo") -> bool:
         with open(cpuinfo) as f:
             return any(line.startswith("flags") and " avx512f" in line for line in f)
     except OSError:  # not Linux: ask NumPy what it found (settings may hide it)
-        from experiments.provenance import simd_record
+        from experiments.trial_dir.provenance import simd_record
 
         return "AVX512F" in simd_record()["dispatched"]
 

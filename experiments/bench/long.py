@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import manifest
-from experiments.file_names import CHECKPOINT_FILE, MANIFEST_DIR, MEMORY_DIR, manifest_name
-from experiments.run.memory_segments import AGENT, read_checkpoint
+from experiments.trial_dir import manifest
+from experiments.trial_dir.layout import CHECKPOINT_FILE, MANIFEST_DIR, MEMORY_DIR, manifest_name
+from experiments.trial_dir.memory_segments import AGENT, read_checkpoint
 from learner.memory import TREE_ROWS, NearestNeighbourMemory
 from learner.sensorimotor_model import MODELS, ModelSpec
 from models.layout import BLOCK_DIM
@@ -82,9 +82,10 @@ def long_figures(
 
 
 def manifest_figures(trial: Path, passes: int = 3) -> Iterator[tuple[str, float, str]]:
-    """What checking the trial's files against its manifest costs (experiments/manifest.py),
-    the best of `passes`: reading its chain and every file's presence and size, as a reader
-    does before it starts; and every file's SHA-256 besides, as all readers together do."""
+    """What checking the trial's files against its manifest costs
+    (experiments/trial_dir/manifest.py), the best of `passes`: reading its chain and every file's
+    presence and size, as a reader does before it starts; and every file's SHA-256 besides, as all
+    readers together do."""
     check, every, files, size = math.inf, math.inf, 0, 0
     for _ in range(passes):
         start = time.perf_counter()

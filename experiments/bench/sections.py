@@ -335,8 +335,8 @@ def long_section() -> Iterator[tuple[str, float, str]]:
 
 def machine_line() -> str:
     """Which machine and which kernels the figures come from."""
-    from experiments import provenance
     from experiments.bench import cpu_classes
+    from experiments.trial_dir import provenance
 
     blas = ", ".join(f"{b['library']} {b['kernel']}" for b in provenance.blas_record())
     simd = provenance.simd_record()

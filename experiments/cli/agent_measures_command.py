@@ -48,7 +48,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 
 def _checked_out(path: Path) -> None:
     """UsageError before any work where the CSV (or figure) cannot be written there."""
-    from experiments import storage
+    from experiments.trial_dir import storage
 
     if path.is_dir():
         raise UsageError(f"--out {path} is a directory: give a file name")
@@ -60,9 +60,9 @@ def _checked_out(path: Path) -> None:
 
 def cmd_replay(args: argparse.Namespace) -> None:
     """The replay test of a batch's finished trials (module docstring)."""
-    from experiments import storage
     from experiments.measure.replay import replay_batch, summaries
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
 
     for path in (args.out, args.figure):
         if path is not None:
@@ -84,9 +84,9 @@ def cmd_replay(args: argparse.Namespace) -> None:
 
 def cmd_voice_memory(args: argparse.Namespace) -> None:
     """What the trials' voice -> toy models remember (module docstring)."""
-    from experiments import storage
     from experiments.measure.voice_memory import trials_table
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
 
     _checked_out(args.out)
     try:

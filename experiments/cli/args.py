@@ -104,7 +104,7 @@ def version_text() -> str:
     """'playroom 0.1.0 (commit ce04631+dirty)', or '(installed package)' outside a checkout."""
     from importlib.metadata import version
 
-    from experiments.provenance import commit_text, source_record
+    from experiments.trial_dir.provenance import commit_text, source_record
 
     source = source_record()
     where = ("commit " if source.get("commit") else "") + commit_text(source)

@@ -71,7 +71,7 @@ def _ignore_signals() -> None:
 
 def fault_line(exc: OSError) -> str:
     """An OSError as one line naming the file and the system's reason."""
-    from experiments import storage
+    from experiments.trial_dir import storage
 
     reason = storage.reason(exc)
     if isinstance(exc, storage.WriteError):
@@ -94,8 +94,8 @@ def _command(argv: list[str], add: str | None = None, drop: str | None = None) -
 def _run_kept(args: argparse.Namespace, argv: list[str], then: str) -> str:
     """What an interrupted or failed `playroom run` kept, and the command that continues it
     (`then`: what to do first, e.g. "free some space, then ")."""
-    from experiments import storage
-    from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, PREVIOUS_CHECKPOINT_FILE
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE, PREVIOUS_CHECKPOINT_FILE
 
     out = Path(args.out)
     if not (out / CONFIG_FILE).exists():  # stopped before the trial was set up

@@ -35,7 +35,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_dirs(given: list[str]) -> list[Path]:
-    from experiments.file_names import BASELINE_FILE
+    from experiments.trial_dir.layout import BASELINE_FILE
 
     dirs: list[Path] = []
     for name in given:
@@ -53,10 +53,10 @@ def _run_dirs(given: list[str]) -> list[Path]:
 
 def cmd_rl_behaviour(args: argparse.Namespace) -> None:
     """The table, printed and written."""
-    from experiments import storage
     from experiments.baseline.behaviour import as_rows, run_behaviour
     from experiments.baseline.settings import BaselineError
     from experiments.baseline.training import rl_library
+    from experiments.trial_dir import storage
 
     runs = _run_dirs(args.runs)  # what is asked for first, then whether it can be done
     try:

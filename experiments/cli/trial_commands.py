@@ -22,7 +22,7 @@ from experiments.cli.args import (
     voice_option,
 )
 from experiments.cli.overrides import merged, random_world
-from experiments.eval_worlds import OWN, WORLD_NAMES
+from experiments.trial_dir.eval_worlds import OWN, WORLD_NAMES
 from learner.config import BABBLING_MODES
 from models.presets import DEFAULT_PRESET, PRESETS
 from sim.config import STICK_RETURNS
@@ -155,10 +155,10 @@ def cmd_random(args: argparse.Namespace) -> None:
 
 def cmd_run(args: argparse.Namespace) -> None:
     """One trial of Model Babbling, written to a directory that survives being killed."""
-    from experiments import storage
     from experiments.run.settings import TrialSettings, resume_settings
     from experiments.run.trial import run_trial
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
 
     # Left out: None. A new trial takes the defaults, a resumed one its own settings.
     given = {name: getattr(args, name) for name in RUN_DEFAULTS if getattr(args, name) is not None}
@@ -191,12 +191,12 @@ def cmd_run(args: argparse.Namespace) -> None:
 
 def cmd_eval(args: argparse.Namespace) -> None:
     """Competence, strategies and vocal accuracy of a trial's final state."""
-    from experiments import storage
-    from experiments.file_names import eval_world_dir
     from experiments.measure.evaluation import EvaluationSettings
     from experiments.measure.trial_evaluation import evaluate_trial
-    from experiments.provenance import computed_on_line
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
+    from experiments.trial_dir.layout import eval_world_dir
+    from experiments.trial_dir.provenance_file import computed_on_line
 
     try:
         summary = evaluate_trial(

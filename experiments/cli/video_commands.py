@@ -83,8 +83,8 @@ def cmd_render(args: argparse.Namespace) -> None:
         gl.for_rendering()  # before anything imports mujoco
     except gl.GLError as exc:
         raise UsageError(str(exc)) from None
-    from experiments import storage
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
     from experiments.video.encoding import RenderError
     from experiments.video.episodes import render_random
     from experiments.video.replay import ReplayError, render_trial

@@ -12,8 +12,8 @@ a random command) acts on the very same placements: normalised competence is
 Every test starts from the same scene: the stick at its start place, the toys at the placement,
 a seeded caregiver position. The trial's own files are read, never written, except the
 evaluation's outputs (`eval.json`, `competence.parquet`, `vocal.parquet`); eval.json names the
-machine it was computed on (`evaluated_on`, experiments/provenance.py). eval.json is standard
-JSON: a number that is not finite (a best distance before any voice movement) is null.
+machine it was computed on (`evaluated_on`, experiments/trial_dir/provenance.py). eval.json is
+standard JSON: a number that is not finite (a best distance before any voice movement) is null.
 """
 
 from __future__ import annotations

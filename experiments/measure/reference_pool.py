@@ -26,7 +26,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from experiments.measure.evaluation import goal_trajectory
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
 from models.layout import MOTOR_DIMS, TOYS, block_slice, context_indices
 
 # Commands per chunk: a multiple of 3 (each placement tests every toy) dividing the study's

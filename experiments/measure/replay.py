@@ -29,16 +29,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments import eval_record, manifest, storage
-from experiments.eval_record import SCENES_KEY
-from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
 from experiments.measure.evaluation import (
     EvaluationSettings,
     goal_trajectory,
     scene_placements,
 )
-from experiments.run.trial_checks import load_trial
-from experiments.run.trial_files import TrialError
+from experiments.run.trial_parts import load_trial
+from experiments.trial_dir import eval_record, manifest, storage
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.eval_record import SCENES_KEY
+from experiments.trial_dir.layout import COMPETENCE_FILE, EVAL_FILE
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom

@@ -21,13 +21,12 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import storage
-from experiments.config_file import with_added_settings
-from experiments.file_names import CONFIG_FILE
-from experiments.log_layout import is_trial_dir
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE, is_trial_dir
 from models.layout import ARM_DIM, N_STEPS, TOYS
 from models.presets import DEFAULT_PRESET
 from models.world import Feedback

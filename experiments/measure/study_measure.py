@@ -198,7 +198,7 @@ def code_digest() -> str:
 
 
 def read_kept(path: Path) -> pd.DataFrame | None:
-    from experiments import storage
+    from experiments.trial_dir import storage
 
     try:
         return storage.read_table(path) if path.exists() else None
@@ -209,7 +209,7 @@ def read_kept(path: Path) -> pd.DataFrame | None:
 def keep(path: Path, reference: pd.DataFrame) -> None:
     """Keep a played reference, if the cache can take it: a report never fails for its cache
     (a full or read-only cache directory only means playing the reference again next time)."""
-    from experiments import storage
+    from experiments.trial_dir import storage
 
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

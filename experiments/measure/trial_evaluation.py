@@ -17,17 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import eval_record, manifest, provenance, storage
-from experiments.eval_record import SCENES_KEY
-from experiments.eval_worlds import OWN, EvalWorldError, own_world, world_record
-from experiments.file_names import (
-    COMPETENCE_FILE,
-    CONFIG_FILE,
-    EVAL_FILE,
-    STUDY_TESTS_FILE,
-    VOCAL_FILE,
-    eval_world_dir,
-)
 from experiments.measure.actors import Actor, LearnerActor
 from experiments.measure.evaluation import (
     EvaluationSettings,
@@ -40,9 +29,21 @@ from experiments.measure.study_measure import (
     StudyMeasureSettings,
     study_tests_of,
 )
-from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.trial_checks import load_trial, remove_litter
-from experiments.run.trial_files import TrialError, TrialLocked, fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts, load_trial
+from experiments.trial_dir import eval_record, manifest, provenance, storage
+from experiments.trial_dir.checks import remove_litter
+from experiments.trial_dir.errors import TrialError, TrialLocked
+from experiments.trial_dir.eval_record import SCENES_KEY
+from experiments.trial_dir.eval_worlds import OWN, EvalWorldError, own_world, world_record
+from experiments.trial_dir.layout import (
+    COMPETENCE_FILE,
+    CONFIG_FILE,
+    EVAL_FILE,
+    STUDY_TESTS_FILE,
+    VOCAL_FILE,
+    eval_world_dir,
+)
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from sim import Playroom
 
 
@@ -59,7 +60,7 @@ def evaluate_trial(
     another process writes into (named). The temporary files of killed writers are removed
     first; `notify` is told their names.
 
-    `world`: an eval world's name (experiments/eval_worlds.py) tests the final agent there
+    `world`: an eval world's name (experiments/trial_dir/eval_worlds.py) tests the final agent there
     and writes into `eval-in-<world>/` instead, the trial's own files untouched; an eval world
     equal to the trial's own is its own evaluation (`notify` is told so)."""
     settings = settings or EvaluationSettings()
@@ -180,9 +181,9 @@ def evaluation_files(summary: dict, tables: dict[str, bytes], config: dict) -> d
     it vouches for the tables (storage.write_files). eval.json lists the tables with their
     sizes and checksums, so that a reader refuses a table lost, damaged or left from another
     evaluation, and records its own checksum and the trial's identity, so that a reader
-    refuses it damaged or another trial's (experiments/eval_record.py). A word's best distance
-    (and so a median) is infinite until the learner's first voice movement: eval.json,
-    standard JSON, holds null for it (experiments/analysis/results.py reads it back as
-    infinity); `summary` itself keeps the numbers."""
+    refuses it damaged or another trial's (experiments/trial_dir/eval_record.py). A word's best
+    distance (and so a median) is infinite until the learner's first voice movement: eval.json,
+    standard JSON, holds null for it (experiments/analysis/results.py reads it back as infinity);
+    `summary` itself keeps the numbers."""
     summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(tables)
     return {**tables, EVAL_FILE: eval_record.evaluation_json(summary, config)}

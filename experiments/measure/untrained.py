@@ -25,7 +25,7 @@ from experiments.measure.study_measure import (
     read_kept,
     study_tests,
 )
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
 
 
 def untrained_tests(config: dict, n_placements: int, cache: Path) -> pd.DataFrame:

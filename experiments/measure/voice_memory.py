@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_parts import load_trial
 from learner.agent import Agent
 from sim import Playroom
 
@@ -65,7 +65,7 @@ def toy_model_rows(agent: Agent, room: Playroom) -> pd.DataFrame:
 
 def trials_table(trial_dirs: list[Path]) -> pd.DataFrame:
     """`toy_model_rows` of each trial's final agent, labelled with its trial and grasp;
-    TrialError (experiments/run/trial_files.py) for a directory that holds no readable
+    TrialError (experiments/trial_dir/errors.py) for a directory that holds no readable
     trial."""
     tables = []
     for trial_dir in trial_dirs:

@@ -37,18 +37,18 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
-from experiments import storage
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import STRATEGIES, vocal_summary
-from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
+from experiments.batch_files import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
 from experiments.report import ablation_data, ablation_tests, paper
 from experiments.report.ablation_page import STUDY_REGIONS, markdown
 from experiments.report.ablation_tests import AblationRow
 from experiments.report.figures import STRATEGY_COLOURS, png_bytes
 from experiments.report.measures import Measure, registry
 from experiments.report.pages import pct
+from experiments.trial_dir import storage
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
 BOOKKEEPING = ("trial.preset", "trial.overrides")

@@ -1,5 +1,5 @@
 """In which rules two groups' worlds differ besides their grasp backend: each backend reads
-settings the other does not (experiments/eval_worlds.py READ_BY, from the world's fields'
+settings the other does not (experiments/trial_dir/eval_worlds.py READ_BY, from the world's fields'
 ACTS_ON), and a difference between the groups is the sum of all of them, not of the grasp
 rule alone. Read from the trials' own config.json, so that the page cannot name a rule its
 trials did not run."""
@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import json
 
-from experiments.eval_worlds import READ_BY
 from experiments.report.ablations import describe_change
+from experiments.trial_dir.eval_worlds import READ_BY
 
 # What describe_change says of two configs that do not differ.
 NO_CHANGE = "the baseline's settings"

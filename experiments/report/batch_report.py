@@ -13,18 +13,18 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments import provenance
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.stats import summarise_batch
-from experiments.file_names import REPORT_FILE
+from experiments.batch_files import REPORT_FILE
 from experiments.report import intro, name_strategies, paper, tool_rule
 from experiments.report.figures import FigureFile, report_figures
 from experiments.report.measures import registry
 from experiments.report.pages import render, settings_table, trials_table, where_table, write_page
 from experiments.report.study_figures import study_figure_files
 from experiments.report.summary import page_summary, summary_files
+from experiments.trial_dir import provenance
 
 
 def write_report(

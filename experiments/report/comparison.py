@@ -16,13 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import provenance
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, ReportError, check_out_dir, collect
 from experiments.analysis.room_measures import RoomMeasures
 from experiments.analysis.trial_tests import ALPHA
 from experiments.analysis.trial_values import VALUE
-from experiments.file_names import COMPARISON_FILE
+from experiments.batch_files import COMPARISON_FILE
 from experiments.report import (
     comparison_data,
     differences,
@@ -48,6 +47,7 @@ from experiments.report.pages import (
     write_page,
 )
 from experiments.report.summary import page_summary, summary_files
+from experiments.trial_dir import provenance
 
 # Random arm commands behind the comparison's stick-grasp rates of the two backends.
 GRASP_RATE_COMMANDS = 1000

@@ -22,12 +22,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import provenance, storage
 from experiments.analysis import step_split
 from experiments.analysis.results import ReportError, check_out_dir
 from experiments.report import ladder, ladder_data
 from experiments.report.ladder_page import completeness_lines, json_records, rungs_table
 from experiments.report.paired_text import cell_text, level_text
+from experiments.trial_dir import provenance, storage
 
 FILES = ("factorial.csv", "factorial-trials.csv", "factorial.json", "factorial.md")
 # Each contrast: its name and its weights on the cells (neither, first, second, both).

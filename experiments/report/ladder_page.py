@@ -15,7 +15,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from experiments import provenance, storage
 from experiments.analysis import step_split
 from experiments.analysis.results import BatchResults, check_out_dir
 from experiments.analysis.trial_tests import ALPHA, survives
@@ -24,6 +23,7 @@ from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
 from experiments.report.pages import machines_text, p_value, seeds_text
 from experiments.report.paired_text import cell_text, level_text
+from experiments.trial_dir import provenance, storage
 
 FILES = ("ladder.csv", ladder_data.FILE, "ladder.json", "ladder.png", "ladder.md")
 HEAD = {k: k.removeprefix("competence_") for k in ladder.COMPETENCE}

@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
 
-from experiments import storage
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
 from experiments.report.figures import FigureFile
+from experiments.trial_dir import storage
 
 
 @dataclass(frozen=True)
@@ -214,7 +214,7 @@ def where_table(results: BatchResults, computed_on: dict[str, str] | None) -> tu
     there; trials from before provenance was recorded count as "not recorded". Returns the
     table and a sentence about trials computed on more than one machine, and about
     `computed_on`, the machine computing the page (provenance's short record)."""
-    from experiments.provenance import SHORT_FIELDS, describe
+    from experiments.trial_dir.provenance import SHORT_FIELDS, describe
 
     where = results.provenance
     if "status" not in where:  # results built without it (none read from a batch)

@@ -15,7 +15,6 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from experiments import storage
 from experiments.analysis.baseline_results import collect_baselines
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.results import BatchResults, check_out_dir, collect
@@ -26,6 +25,7 @@ from experiments.report.ladder import COMPETENCE
 from experiments.report.ladder_page import json_records
 from experiments.report.pages import machines_text, p_value, seeds_text
 from experiments.report.paired_text import level_text, signed_text
+from experiments.trial_dir import storage
 
 FILES = ("rl-compare.csv", "rl-compare.json", "rl-compare.png", "rl-compare.md")
 COLOURS = {rl.MODEL_BABBLING: "tab:blue", rl.SAC_HER: "tab:orange"}

@@ -4,8 +4,8 @@ the ladder's page (experiments/report/ladder_page.py) reads it.
 A step between rungs of one backend changes what their configs say. A step from one backend to
 the other changes more than its configs say, and the page must not hide any of it:
 - every setting whose value differs, each said with which rung reads it (a setting only one
-  backend reads, experiments/eval_worlds.py READ_BY: "not read by the earlier rung's kinematic
-  backend" where the earlier rung had no such rule at all, rather than a change it made);
+  backend reads, experiments/trial_dir/eval_worlds.py READ_BY: "not read by the earlier rung's
+  kinematic backend" where the earlier rung had no such rule at all, rather than a change it made);
 - every setting only one of the two backends reads, even where its value did not change (a
   rule one rung applies and the other does not: the kinematic catch distance, the physical
   stick-return reach);
@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from experiments.eval_worlds import READ_BY, SWITCHES
 from experiments.report.ablations import describe_change
+from experiments.trial_dir.eval_worlds import READ_BY, SWITCHES
 
 # What each recorded capability means on the page (backend.json's fields, CAPABILITIES).
 CAPABILITY_TEXT = {

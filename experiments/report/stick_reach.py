@@ -7,7 +7,7 @@ reach docs/protocol.md D14 proposes; docs/stick-grasp-rate.png was drawn by
 
 which also prints the table (markdown) and, per backend, the distance `falling_rate_distance`
 finds where it finds one. Each backend's reach is drawn as its trials recorded it
-(experiments/backend_record.py): any set of backends, none known here by name.
+(experiments/trial_dir/backend_record.py): any set of backends, none known here by name.
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from experiments import backend_record, provenance, storage
 from experiments.analysis.curves import falling_rate_distance, grasp_rate_by_distance
 from experiments.analysis.logs import read_log
-from experiments.file_names import CONFIG_FILE
 from experiments.report.figures import group_colour, png_bytes
+from experiments.trial_dir import backend_record, provenance, storage
+from experiments.trial_dir.layout import CONFIG_FILE
 
 # The proposal's rule (falling_rate_distance): the first 1 cm bin beyond the start pose's whose
 # grasp rate is below half of the start's, among bins of at least 100 arm movements.

@@ -42,15 +42,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from experiments import storage
 from experiments.analysis.mechanisms import LABELS
 from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
 from experiments.analysis.stats import STRATEGIES
-from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
+from experiments.batch_files import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
 from experiments.report.differences import Evaluated, per_trial_values, tests_summary
 from experiments.report.measures import Measure
 from experiments.report.pages import Table
 from experiments.report.paper import PaperNumber
+from experiments.trial_dir import storage
 
 CSV_COLUMNS = ["group", "measure", "statistic", "scope", "value", "low", "high", "n"]
 # Per-trial numbers of BatchResults.trials kept in the summary, beside its trial and group.

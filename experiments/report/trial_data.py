@@ -21,8 +21,8 @@ import pandas as pd
 
 from experiments.analysis.results import BatchResults
 from experiments.analysis.trial_values import VALUE
-from experiments.provenance import SHORT_FIELDS, describe
 from experiments.report.measures import Measure
+from experiments.trial_dir.provenance import SHORT_FIELDS, describe
 
 WHO = ["computed_on", "computed_commit", "evaluated_on", "evaluated_commit"]
 NOT_RECORDED = "not recorded"

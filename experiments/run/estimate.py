@@ -2,7 +2,7 @@
 
 The disk a trial holds at its end grows with its iterations: a row of logs each, and the
 learner's memory, each row of it written once, in the segment of the checkpoint period that
-stored it (experiments/run/memory_segments.py), beside two checkpoints of a fixed size. The
+stored it (experiments/trial_dir/memory_segments.py), beside two checkpoints of a fixed size. The
 bytes it writes grow as the disk does, in proportion to the iterations (before segments, every
 checkpoint rewrote every row: they grew with the square). Its time per iteration grows with the
 learner's memory, less than in proportion to it since older rows are searched through trees
@@ -26,15 +26,9 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from experiments import storage
-from experiments.file_names import (
-    CHECKPOINT_FILE,
-    LOG_DIR,
-    MEMORY_DIR,
-    PREVIOUS_CHECKPOINT_FILE,
-)
 from experiments.run.settings import TrialSettings
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir.checkpoint import progress
+from experiments.trial_dir.errors import TrialError
 
 # Seconds of an iteration, by grasp backend: 5293 and 559 iterations a second over trials of
 # 5000 iterations (docs/speed.md, `playroom bench trial`, which measures every registered
@@ -90,7 +84,7 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
     """TrialError (one line) if the trial's files will not fit on the disk of `out_dir`, with
     what it holds there already; else the line that states a long trial's costs (trials longer
     than LONG_TRIAL iterations, with iterations left to run), or None."""
-    start, held = _progress(out_dir) if resume else (0, 0)
+    start, held = progress(out_dir) if resume else (0, 0)
     costs = trial_costs(settings, start)
     free = _free_space(_existing(out_dir))
     need = costs.disk_bytes - held
@@ -124,7 +118,7 @@ def check_batch_fits(out_dir: Path, trials: list[tuple[Path, TrialSettings]]) ->
     batch's costs (its trials' seconds, if one process ran them all, and disk), or None."""
     costs, held = [], 0
     for trial_dir, settings in trials:
-        start, on_disk = _progress(trial_dir) if trial_dir.is_dir() else (0, 0)
+        start, on_disk = progress(trial_dir) if trial_dir.is_dir() else (0, 0)
         costs.append(trial_costs(settings, start))
         held += on_disk
     need = sum(c.disk_bytes for c in costs) - held
@@ -162,23 +156,6 @@ def growth_seconds(iterations: int) -> float:
 def _per_iteration(grasp: str) -> float:
     """Seconds of an iteration of a backend; a backend not measured yet, the slowest's."""
     return SECONDS_PER_ITERATION.get(grasp, max(SECONDS_PER_ITERATION.values()))
-
-
-def _progress(out_dir: Path) -> tuple[int, int]:
-    """(iteration of the newest readable checkpoint, bytes of checkpoints, memory segments and
-    logs) of a trial to be resumed; (0, 0) where there is none yet. A resume checks the trial
-    itself."""
-    iteration = 0
-    for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
-        try:
-            iteration = int(storage.read_meta(out_dir / name)["iteration"])
-            break
-        except (storage.CorruptFileError, KeyError, TypeError, ValueError):
-            continue
-    files = [out_dir / CHECKPOINT_FILE, out_dir / PREVIOUS_CHECKPOINT_FILE]
-    for folder in (LOG_DIR, MEMORY_DIR):
-        files += [p for p in (out_dir / folder).rglob("*") if p.is_file()]
-    return iteration, sum(p.stat().st_size for p in files if p.is_file())
 
 
 def _free_space(folder: Path) -> int | None:

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from experiments import storage
-from experiments.config_file import WORLD_CHOICES
-from experiments.file_names import CONFIG_FILE
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import WORLD_CHOICES
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import CONFIG_FILE
 from learner.config import BABBLING_MODES, LearnerConfig
 from models.checks import INT64_MAX, check_seed
 from models.presets import DEFAULT_PRESET, PRESETS

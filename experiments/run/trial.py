@@ -1,15 +1,15 @@
 """One trial: the Model Babbling agent playing in one room, written to a directory that
-survives being killed (its files: experiments/run/trial_files.py).
+survives being killed (its files: experiments/trial_dir/layout.py).
 
 Each file is written atomically, and a log chunk, like the segment of the memory's new rows
-(experiments/run/memory_segments.py), is always written before the checkpoint that covers it,
+(experiments/trial_dir/memory_segments.py), is always written before the checkpoint that covers it,
 so a run killed at any moment resumes from its last checkpoint and rewrites the same chunks and
 segments: the final memory and logs equal those of an uninterrupted run.
 
-One process writes into a trial directory at a time (experiments/run/lock.py). Resuming with more
-iterations than the trial was asked for extends it: the result equals a run asked for the
-larger number from the start, and files derived from the shorter run (its evaluation) are
-moved aside into `stale-at-NNNNNNNN/`.
+One process writes into a trial directory at a time (experiments/trial_dir/lock.py). Resuming with
+more iterations than the trial was asked for extends it: the result equals a run asked for the
+larger number from the start, and files derived from the shorter run (its evaluation) are moved
+aside into `stale-at-NNNNNNNN/`.
 """
 
 from __future__ import annotations
@@ -23,20 +23,32 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import backend_record, manifest, provenance, storage
-from experiments.file_names import (
-    BACKEND_FILE,
-    CHECKPOINT_FILE,
-    MEMORY_DIR,
-    PREVIOUS_CHECKPOINT_FILE,
-)
-from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_path
-from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
-from experiments.run import memory_segments, progress_bar, stop_requests
+from experiments.run import estimate, progress_bar, stop_requests
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import typed_config
-from experiments.run.trial_files import WORDS_LOG_PERIOD, learner_values, log_row, trial_parts
-from experiments.run.trial_opening import OpenedTrial, open_trial_directory
+from experiments.run.trial_parts import learner_values, log_row, trial_parts
+from experiments.trial_dir import (
+    backend_record,
+    manifest,
+    memory_segments,
+    provenance_file,
+    storage,
+)
+from experiments.trial_dir.layout import (
+    BACKEND_FILE,
+    CHECKPOINT_FILE,
+    CHUNK_IDENTITY_KEY,
+    MEMORY_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+    chunk_path,
+)
+from experiments.trial_dir.log_schema import (
+    LEARNER_COLUMNS,
+    LEARNER_DTYPE,
+    SOURCE_COLUMNS,
+    WORDS_LOG_PERIOD,
+)
+from experiments.trial_dir.opening import OpenedTrial, open_trial_directory
 from models.layout import TOYS, block_slice
 
 _SOUND = block_slice("sound")
@@ -49,7 +61,7 @@ class Trial:
 
     Its opening reads from top to bottom: the settings typed once, the room and agent built
     from them (before anything is written: a config that makes no room or agent leaves the
-    directory as it was), the directory opened (experiments/run/trial_opening.py: checked,
+    directory as it was), the directory opened (experiments/trial_dir/opening.py: checked,
     locked, config.json written or compared, a resume's checkpoint restored into those parts),
     who computes recorded (provenance.json), what the backend declares recorded
     (backend.json)."""
@@ -64,12 +76,14 @@ class Trial:
             trial_parts, settings.grasp, settings.seed, typed.world, typed.voice, typed.learner
         )
         parts = build()
-        opened = open_trial_directory(out_dir, settings, self.config, parts, build, resume)
+        words = len(parts[1].vocal_tract.config.words)
+        fits = functools.partial(estimate.check_fits, settings=settings, resume=resume)
+        opened = open_trial_directory(out_dir, self.config, parts, build, resume, words, fits)
         self._lock = opened.lock  # held from here: `close` gives it up
         try:
             self._take(opened)
             if not self.finished:  # who computes from here on (provenance.json)
-                self.notices += provenance.record_start(
+                self.notices += provenance_file.record_start(
                     self.dir, self.iteration, self.room.vocal_tract.data_record()
                 )
             self._record_backend()
@@ -125,7 +139,7 @@ class Trial:
         if memory.newest != self.memory.newest:
             self.unrecorded.append(self.dir / MEMORY_DIR / str(memory.newest))
         # Every file written since the last checkpoint, recorded before the checkpoint that
-        # names the record (experiments/manifest.py).
+        # names the record (experiments/trial_dir/manifest.py).
         pointer = manifest.write_period(
             self.dir, self.iteration, self.manifest_pointer, self.unrecorded, self.identity
         )
@@ -183,7 +197,7 @@ class Trial:
         if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
             # A checkpoint before the first log chunk: a directory with logs then always has
             # a checkpoint, unless it was lost, and a resume can tell which
-            # (experiments/run/trial_checks.py, `prepare_resume`).
+            # (experiments/trial_dir/resume.py, `prepare_resume`).
             self._save_checkpoint()
         rows: list[tuple[dict, np.ndarray]] = []
         word_rows: list[dict] = []
@@ -248,7 +262,7 @@ class Trial:
             table.insert(position, column, self.source[column])
         path = chunk_path(self.dir, kind, start)
         path.parent.mkdir(exist_ok=True)
-        # Written into the Parquet schema's metadata (experiments/log_layout.py).
+        # Written into the Parquet schema's metadata (experiments/trial_dir/layout.py).
         table.attrs[CHUNK_IDENTITY_KEY] = self.identity
         storage.write_table(path, table, plain=plain)
         self.unrecorded.append(path)

@@ -11,9 +11,9 @@ import json
 from importlib.metadata import version
 from typing import NamedTuple
 
-from experiments.config_file import WORLD_CHOICES
 from experiments.run.settings import TrialSettings
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir.config_file import WORLD_CHOICES
+from experiments.trial_dir.errors import TrialError
 from learner.config import LearnerConfig, learner_preset
 from sim.config import WorldConfig, inert_settings, world_preset
 from sim.physics import PlayroomPhysics
@@ -23,7 +23,7 @@ from sim.vocal.diva.data import DivaDataError, DivaDataMissing, installed_fit
 
 class TypedConfig(NamedTuple):
     """A trial's settings typed once: its world, voice and learner configs, from which its room
-    and agent are built (`trial_files.trial_parts`), and `json`, the same as config.json holds
+    and agent are built (`trial_parts.trial_parts`), and `json`, the same as config.json holds
     them."""
 
     world: WorldConfig

@@ -17,7 +17,7 @@ import imageio_ffmpeg
 import mediapy
 import numpy as np
 
-from experiments import storage
+from experiments.trial_dir import storage
 
 # Quality of the H.264 stream (constant rate factor: lower is better and larger).
 VIDEO_CRF = 20

@@ -16,12 +16,12 @@ from pathlib import Path
 import pandas as pd
 from tqdm import tqdm
 
-from experiments import storage
 from experiments.analysis.logs import read_log
-from experiments.config_file import with_added_settings
-from experiments.file_names import CONFIG_FILE
-from experiments.log_schema import ITERATION, STICK_GRASPED, TOY_MOVED_BY, WORD_RECOGNISED
-from experiments.run.trial_files import fresh_trial_parts, log_row
+from experiments.run.trial_parts import fresh_trial_parts, log_row
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir.log_schema import ITERATION, STICK_GRASPED, TOY_MOVED_BY, WORD_RECOGNISED
 from experiments.video.episodes import (
     EpisodeRenderer,
     check_output_path,

@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from experiments import storage
-from experiments.config_file import with_added_settings
-from experiments.file_names import CONFIG_FILE
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import CONFIG_FILE
 from models.layout import ARM_DIM, VOICE_DIM
 from models.presets import DEFAULT_PRESET
 from models.world import Feedback

@@ -11,11 +11,11 @@ import pytest
 from baseline_runs import write_run
 from bit_flips import flip_number
 
-from experiments import storage
 from experiments.analysis.baseline_results import collect_baselines
 from experiments.analysis.results import ReportError
 from experiments.baseline.settings import BaselineSettings, run_name
-from experiments.file_names import COMPETENCE_FILE, EVAL_FILE
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import COMPETENCE_FILE, EVAL_FILE
 
 
 @pytest.fixture

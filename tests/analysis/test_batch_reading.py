@@ -8,18 +8,15 @@ import shutil
 
 import pytest
 
-from experiments import storage
 from experiments.analysis.batch_checks import BatchMismatch
 from experiments.analysis.logs import read_batch_logs
+from experiments.batch_files import REPORT_FILE
 from experiments.batches.runner import is_complete
 from experiments.cli.main import main
-from experiments.file_names import (
-    LOG_DIR,
-    REPORT_FILE,
-    STUDY_TESTS_FILE,
-)
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import LOG_DIR, STUDY_TESTS_FILE
 
 
 @pytest.fixture

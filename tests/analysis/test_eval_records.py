@@ -2,7 +2,7 @@
 digit that leaves valid JSON) or another trial's (copied in whole, with its tables) is refused
 in one line naming it and what to do, never reported, and a batch rerun evaluates it again;
 an eval.json from before it recorded its checksum is read with one warning
-(experiments/eval_record.py)."""
+(experiments/trial_dir/eval_record.py)."""
 
 from __future__ import annotations
 
@@ -15,12 +15,13 @@ import pytest
 from bit_flips import flip_bit, flip_number
 from old_trials import as_before_eval_checksums
 
-from experiments import eval_record, manifest, storage
 from experiments.analysis import cross_worlds
 from experiments.analysis.results import ReportError, collect
+from experiments.batch_files import REPORT_FILE
 from experiments.batches.runner import is_complete
 from experiments.cli.main import main
-from experiments.file_names import EVAL_FILE, EVALUATION_TABLES, REPORT_FILE, VOCAL_FILE
+from experiments.trial_dir import eval_record, manifest, storage
+from experiments.trial_dir.layout import EVAL_FILE, EVALUATION_TABLES, VOCAL_FILE
 
 FIRST, SECOND = "kinematic-random-seed0000", "kinematic-random-seed0001"
 # Random commands per ring of the report's study reference: the fewest that make a page.

@@ -10,16 +10,16 @@ import pytest
 from bit_flips import flip_number
 from old_trials import rewritten_evaluation
 
-from experiments import storage
 from experiments.analysis.eval_world_results import collect
 from experiments.analysis.results import ReportError
 from experiments.analysis.results import collect as collect_own
 from experiments.batches.runner import eval_world_complete
-from experiments.file_names import COMPETENCE_FILE, CONFIG_FILE, EVAL_FILE, eval_world_dir
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import COMPETENCE_FILE, CONFIG_FILE, EVAL_FILE, eval_world_dir
 
 ONE = EvaluationSettings(n_placements=1)
 

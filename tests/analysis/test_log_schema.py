@@ -1,6 +1,6 @@
-"""The logs' columns, declared once (experiments/log_schema.py): recorded logs hold them in the
-declared types, a trial written before a column existed reads it as declared (missing where it
-did not record it), a number computed from such a column is missing while the trial's other
+"""The logs' columns, declared once (experiments/trial_dir/log_schema.py): recorded logs hold them
+in the declared types, a trial written before a column existed reads it as declared (missing where
+it did not record it), a number computed from such a column is missing while the trial's other
 numbers stay, and docs/learning.md shows the declared table."""
 
 from __future__ import annotations
@@ -13,13 +13,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments import storage
 from experiments.analysis.curves import curve_rows, grasp_rate_by_distance, tool_numbers
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LABELS, trial_mechanisms
-from experiments.file_names import CONFIG_FILE
-from experiments.log_layout import chunk_path
-from experiments.log_schema import (
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CONFIG_FILE, chunk_path
+from experiments.trial_dir.log_schema import (
     GOAL_COLUMNS,
     ITERATION,
     ITERATIONS,
@@ -153,8 +152,8 @@ def test_a_column_older_trials_lack_reads_as_declared_in_a_type_that_holds_it():
 def test_the_docs_show_the_declared_table():
     page = (ROOT / "docs" / "learning.md").read_text()
     assert with_table(page) == page, (
-        "docs/learning.md's log columns differ from experiments/log_schema.py: run "
-        "`.venv/bin/python -m experiments.log_schema docs/learning.md`"
+        "docs/learning.md's log columns differ from experiments/trial_dir/log_schema.py: run "
+        "`.venv/bin/python -m experiments.trial_dir.log_schema docs/learning.md`"
     )
     assert column_table() in page
     for column in ITERATIONS:

@@ -16,14 +16,10 @@ from rl_extra import require_stable_baselines3
 
 require_stable_baselines3()
 
-from experiments import manifest, storage  # noqa: E402
 from experiments.baseline.run import policy_file  # noqa: E402
 from experiments.cli.main import main  # noqa: E402
-from experiments.file_names import (  # noqa: E402
-    BASELINE_FILE,
-    EVALUATION_TABLES,
-    TRAINING_FILE,
-)
+from experiments.trial_dir import manifest, storage  # noqa: E402
+from experiments.trial_dir.layout import BASELINE_FILE, EVALUATION_TABLES, TRAINING_FILE  # noqa: E402
 
 pytestmark = pytest.mark.slow
 

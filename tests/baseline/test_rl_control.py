@@ -13,7 +13,6 @@ from rl_extra import require_stable_baselines3
 
 require_stable_baselines3()
 
-from experiments import storage  # noqa: E402
 from experiments.baseline import control_learner as cl  # noqa: E402
 from experiments.baseline.control_run import COLUMNS, goal_id, run_one  # noqa: E402
 from experiments.baseline.control_settings import (  # noqa: E402
@@ -24,6 +23,7 @@ from experiments.baseline.control_settings import (  # noqa: E402
     library_defaults,
 )
 from experiments.cli.main import main  # noqa: E402
+from experiments.trial_dir import storage  # noqa: E402
 
 pytestmark = pytest.mark.slow
 

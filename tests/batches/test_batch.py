@@ -12,13 +12,13 @@ from pathlib import Path
 
 import pytest
 
-from experiments import eval_record, storage
 from experiments.analysis.logs import read_log
 from experiments.batches import scheduler as scheduler_module
 from experiments.batches.runner import is_complete, run_batch
 from experiments.batches.spec import BatchError, BatchSpec, load_spec
 from experiments.cli.main import main
-from experiments.file_names import CHECKPOINT_FILE, TIMING_FILE
+from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE, TIMING_FILE
 
 
 @pytest.fixture(scope="module")
@@ -220,7 +220,7 @@ def test_a_batch_says_when_a_trial_waits_for_another_writer(tmp_path, client):
     spec = _tiny()
     trial = tmp_path / spec.trials()[0][0]
     trial.mkdir()
-    # Another process writes the trial (its lock taken as experiments/run/lock.py takes it).
+    # Another process writes the trial (its lock taken as experiments/trial_dir/lock.py takes it).
     holder = subprocess.Popen(
         [sys.executable, "-c", _HOLD, str(trial / ".lock")],
         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,

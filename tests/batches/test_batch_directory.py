@@ -13,16 +13,17 @@ from pathlib import Path
 
 import pytest
 
-from experiments import storage
 from experiments.analysis.finished import IncompleteTrialsWarning
 from experiments.analysis.logs import read_batch_logs
 from experiments.analysis.results import ReportError, collect
+from experiments.batch_files import BATCH_FILE
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches.directory import check_directory
 from experiments.batches.runner import run_batch
 from experiments.batches.spec import BatchError, load_spec
 from experiments.cli.main import main
-from experiments.file_names import BATCH_FILE, CONFIG_FILE
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CONFIG_FILE
 
 CONFIG = {
     "grasps": ["kinematic"],

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from experiments import storage
 from experiments.batches.runner import eval_world_complete, run_batch
 from experiments.batches.spec import BatchError, BatchSpec, load_spec
-from experiments.file_names import COMPETENCE_FILE, EVAL_FILE, LOCK_FILE, eval_world_dir
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import COMPETENCE_FILE, EVAL_FILE, LOCK_FILE, eval_world_dir
 
 SPEC = BatchSpec(
     grasps=("kinematic", "physical"),

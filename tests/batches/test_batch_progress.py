@@ -10,13 +10,13 @@ import urllib.request
 
 import pytest
 
-from experiments import storage
 from experiments.analysis.batch_record import recorded_reference_commands
+from experiments.batch_files import BATCH_FILE
 from experiments.batches import progress as progress_module
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches.runner import run_batch
 from experiments.batches.spec import BatchSpec
-from experiments.file_names import BATCH_FILE
+from experiments.trial_dir import storage
 
 TINY = BatchSpec(
     grasps=("kinematic",),

@@ -10,10 +10,11 @@ import shutil
 
 import pytest
 
-from experiments import storage
+from experiments.batch_files import BATCH_FILE, REPORT_FILE
 from experiments.batches.spec import load_spec, spec_record
 from experiments.cli.main import main
-from experiments.file_names import BATCH_FILE, CONFIG_FILE, REPORT_FILE
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CONFIG_FILE
 
 
 def _cli(capsys, *argv: str) -> tuple[int, list[str]]:

@@ -16,7 +16,7 @@ import pytest
 from experiments.batches import runner
 from experiments.batches.runner import TrialFailed, is_complete, run_and_evaluate, run_batch
 from experiments.batches.spec import BatchError, BatchSpec
-from experiments.file_names import LOG_DIR
+from experiments.trial_dir.layout import LOG_DIR
 
 SPEC = BatchSpec(
     grasps=("kinematic",), seeds=(0, 1, 2), iterations=10, checkpoint_every=10, eval_placements=1

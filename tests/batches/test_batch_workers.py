@@ -20,7 +20,7 @@ from experiments.batches import scheduler as scheduler_module
 from experiments.batches import worker_check, workers
 from experiments.batches.runner import run_batch
 from experiments.batches.spec import BatchError, BatchSpec
-from experiments.run.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 
 REPO = Path(__file__).resolve().parents[2]
 TINY = BatchSpec(grasps=("kinematic",), seeds=(0,), iterations=10, checkpoint_every=10)

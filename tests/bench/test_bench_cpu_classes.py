@@ -36,7 +36,7 @@ def test_emulation_replaces_settings_already_made(monkeypatch) -> None:
 def test_a_process_started_with_the_settings_runs_the_older_kernels() -> None:
     cpu = cpu_classes.emulated_class()
     script = (
-        "import json; from experiments import provenance as p; "
+        "import json; from experiments.trial_dir import provenance as p; "
         "print(json.dumps([p.simd_record()['dispatched'], p.blas_record(), p.numba_target()]))"
     )
     out = subprocess.run(

@@ -15,17 +15,17 @@ import pytest
 from old_trials import before_manifests
 from trial_logs import same_logs
 
-from experiments import storage
 from experiments.analysis.results import ReportError
 from experiments.cli.main import main
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE, LOCK_FILE
 from experiments.measure import study_measure
 from experiments.measure.for_reports import room_measures
 from experiments.report.batch_report import write_report
 from experiments.report.figures import FigureFile
-from experiments.run.memory_segments import read_checkpoint
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE, LOCK_FILE
+from experiments.trial_dir.memory_segments import read_checkpoint
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

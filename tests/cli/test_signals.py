@@ -17,11 +17,11 @@ from pathlib import Path
 
 import pytest
 
-from experiments import storage
 from experiments.analysis.logs import read_log
 from experiments.cli import faults
-from experiments.file_names import CHECKPOINT_FILE
-from experiments.run.lock import DirectoryLock
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE
+from experiments.trial_dir.lock import DirectoryLock
 
 # -X faulthandler: a run that outlives its signal shows where it was (SIGABRT below).
 PLAYROOM = [sys.executable, "-X", "faulthandler", "-m", "experiments.cli.main"]

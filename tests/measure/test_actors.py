@@ -18,7 +18,7 @@ from experiments.measure.evaluation import (
 )
 from experiments.measure.policy_actor import PolicyActor, goal_end, observation_of
 from experiments.measure.study_measure import StudyMeasureSettings, study_tests_of
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
 from models.layout import ARM_DIM
 from sim.envs.goal_env import PlayroomGoalEnv
 from sim.envs.gym_env import ARM_PART, VOICE_PART

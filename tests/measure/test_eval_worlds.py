@@ -14,9 +14,12 @@ import sys
 import numpy as np
 import pytest
 
-from experiments import eval_worlds, storage
 from experiments.cli.main import main
-from experiments.eval_worlds import (
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_config import full_config
+from experiments.trial_dir import eval_worlds, storage
+from experiments.trial_dir.eval_worlds import (
     EVAL_WORLDS,
     READ_BY,
     SWITCHES,
@@ -25,7 +28,7 @@ from experiments.eval_worlds import (
     world_record,
     world_settings,
 )
-from experiments.file_names import (
+from experiments.trial_dir.layout import (
     COMPETENCE_FILE,
     EVAL_FILE,
     EVALUATION_TABLES,
@@ -33,9 +36,6 @@ from experiments.file_names import (
     STALE_PREFIX,
     eval_world_dir,
 )
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_config import full_config
 from models.layout import ARM_DIM
 from sim import Playroom
 from sim.config import world_preset

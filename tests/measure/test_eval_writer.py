@@ -12,7 +12,9 @@ import sys
 import pytest
 
 from experiments.cli.main import main
-from experiments.file_names import (
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     COMPETENCE_FILE,
     EVAL_FILE,
@@ -20,13 +22,11 @@ from experiments.file_names import (
     PREVIOUS_CHECKPOINT_FILE,
     VOCAL_FILE,
 )
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
 
 # A writer that holds a trial's lock until its standard input is closed.
 HOLD_LOCK = """
 import sys
-from experiments.run.lock import DirectoryLock
+from experiments.trial_dir.lock import DirectoryLock
 DirectoryLock(sys.argv[1]).acquire()
 print("locked", flush=True)
 sys.stdin.read()

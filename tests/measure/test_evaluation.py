@@ -20,7 +20,7 @@ from experiments.measure.evaluation import (
     strategy_of,
 )
 from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_parts import load_trial
 from models.layout import ARM_DIM
 from sim import Playroom
 from sim import events as ev

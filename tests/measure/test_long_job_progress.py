@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import argparse
 
-from experiments import storage
+from experiments.batch_files import BATCH_FILE
 from experiments.cli.report_commands import study_reference
-from experiments.file_names import BATCH_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
+from experiments.trial_dir import storage
 
 
 def test_the_random_reference_draws_a_bar_of_its_commands(capsys):

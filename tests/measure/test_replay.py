@@ -7,7 +7,7 @@ import numpy as np
 
 from experiments.measure.evaluation import EvaluationSettings, competence_table
 from experiments.measure.replay import SCENES, replay_table
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_parts import load_trial
 
 
 def test_the_test_scene_is_the_evaluations_and_a_remembered_scene_brings_the_outcome_back(

@@ -10,15 +10,15 @@ import shutil
 import numpy as np
 import pytest
 
-from experiments import storage
 from experiments.cli.main import main
-from experiments.eval_record import SCENES_KEY, read_evaluation
 from experiments.measure.evaluation import (
     EvaluationSettings,
     competence_table,
     scene_placements,
 )
 from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.eval_record import SCENES_KEY, read_evaluation
 from sim import Playroom
 from sim.config import world_preset
 

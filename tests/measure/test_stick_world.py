@@ -11,7 +11,7 @@ from experiments.cli.report_commands import study_reference
 from experiments.measure.stick import batch_worlds, grasp_rates
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
-from experiments.storage import write_json
+from experiments.trial_dir.storage import write_json
 from sim.config import world_preset
 
 COMMANDS = 200

@@ -14,7 +14,7 @@ from experiments.measure.study_measure import (
     random_reference,
     study_tests,
 )
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_parts import load_trial
 from sim.config import world_preset
 
 # The world these tests were written for: the project preset (explicit, as Playroom() takes

@@ -15,7 +15,7 @@ from experiments.measure.for_reports import room_measures
 from experiments.measure.study_measure import StudyMeasureSettings, random_reference, study_tests
 from experiments.measure.untrained import untrained_numbers, untrained_tests
 from experiments.report.batch_report import write_report
-from experiments.run.trial_files import fresh_trial_parts
+from experiments.run.trial_parts import fresh_trial_parts
 
 
 def test_an_untrained_agent_leaves_the_arm_at_rest_and_is_kept(batches, tmp_path):

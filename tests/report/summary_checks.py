@@ -11,8 +11,8 @@ import re
 import pandas as pd
 import pytest
 
-from experiments import provenance
-from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
+from experiments.batch_files import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
+from experiments.trial_dir import provenance
 
 
 def _rows(page: str) -> list[list[str]]:

@@ -18,14 +18,14 @@ from scipy import stats
 
 from experiments.analysis.results import ReportError
 from experiments.analysis.stats import paired_difference
-from experiments.file_names import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
+from experiments.batch_files import ABLATION_CSV_FILE, ABLATION_FIGURE_FILE, ABLATION_TABLE_FILE
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.for_reports import room_measures
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.report.ablations import ablation_rows, write_ablations
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.storage import config_differences
+from experiments.trial_dir.storage import config_differences
 
 COMMANDS = 20  # random commands per ring behind the study's measure: enough to compute it
 

@@ -12,13 +12,13 @@ import pytest
 
 from experiments.analysis.mechanisms import LABELS, LOG_COLUMNS, trial_mechanisms
 from experiments.analysis.strategies import held_strategy, share_intervals
-from experiments.log_schema import (
+from experiments.report.mechanisms import ring_outcomes
+from experiments.trial_dir.log_schema import (
     GOAL_COLUMNS,
     REACHED_COLUMNS,
     STICK_MOVED_BY,
     WORD_RECOGNISED,
 )
-from experiments.report.mechanisms import ring_outcomes
 
 NAMES = {"oey", "uye", "iuo"}
 WORDS = NAMES | {"eyu", "eou", "yeo"}

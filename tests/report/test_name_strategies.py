@@ -11,7 +11,6 @@ import pytest
 from old_trials import as_evaluated_before_names_had_toys
 
 from experiments.analysis.results import collect
-from experiments.file_names import EVAL_FILE
 from experiments.measure.for_reports import room_measures
 from experiments.report.batch_report import write_report
 from experiments.report.name_strategies import (
@@ -20,6 +19,7 @@ from experiments.report.name_strategies import (
     named_tests,
     strategy_shares,
 )
+from experiments.trial_dir.layout import EVAL_FILE
 
 
 def _results(batches) -> object:

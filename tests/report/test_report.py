@@ -22,18 +22,19 @@ from page_checks import check_explained
 from summary_checks import check_summary
 from trial_recompute import check_trials_file
 
-from experiments import storage
 from experiments.analysis.curves import curve_rows, tool_numbers
 from experiments.analysis.results import ReportError, collect
 from experiments.analysis.stats import (
     cost_per_iteration,
 )
-from experiments.file_names import COMPARISON_FILE, EVAL_FILE, REPORT_FILE
-from experiments.log_layout import CHUNK_IDENTITY_KEY, trial_identity
+from experiments.batch_files import COMPARISON_FILE, REPORT_FILE
 from experiments.measure.for_reports import room_measures
 from experiments.report import figures, paper
 from experiments.report.batch_report import write_report
 from experiments.report.comparison import write_comparison
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import trial_identity
+from experiments.trial_dir.layout import CHUNK_IDENTITY_KEY, EVAL_FILE
 
 DATA_URI = re.compile(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"')
 

@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from experiments import storage
 from experiments.analysis.curves import falling_rate_distance, grasp_rate_by_distance
-from experiments.file_names import BACKEND_FILE, CONFIG_FILE, LOG_DIR
 from experiments.report import stick_reach
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import BACKEND_FILE, CONFIG_FILE, LOG_DIR
 
 
 def _log(rows: list[tuple[str, float, bool]]) -> pd.DataFrame:
@@ -96,7 +96,7 @@ def test_the_command_draws_the_figure_and_prints_the_table(tmp_path, capsys):
 
 def test_each_backend_is_drawn_at_the_reach_its_trials_recorded(tmp_path):
     """Any backends, none known by name: a trial's backend.json gives its reach; a trial
-    written before the record, its config (experiments/backend_record.py)."""
+    written before the record, its config (experiments/trial_dir/backend_record.py)."""
     batch = tmp_path / "batch"
     world = {"segment_lengths": [0.25, 0.15, 0.1], "grasp_distance": 0.1}
     world |= {"stick_start_handle": [-0.25, 0.0]}

@@ -10,7 +10,7 @@ import math
 
 import pandas as pd
 
-from experiments.file_names import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
+from experiments.batch_files import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
 from experiments.report.summary import CSV_COLUMNS, summary_files
 
 

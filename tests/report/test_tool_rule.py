@@ -112,7 +112,7 @@ def test_trials_without_the_stick_motion_are_not_recorded_and_not_tested():
 
 def test_study_tests_keep_the_stick_motion_their_rule_compared(trained_trial):
     from experiments.measure.study_measure import StudyMeasureSettings, study_tests
-    from experiments.run.trial_checks import load_trial
+    from experiments.run.trial_parts import load_trial
 
     _, agent, room, _ = load_trial(trained_trial.dir)
     tests = study_tests(agent, room, StudyMeasureSettings(n_placements=2))

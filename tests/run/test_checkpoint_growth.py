@@ -12,12 +12,12 @@ from pathlib import Path
 from old_trials import as_before_manifests
 from trial_states import SEGMENTED, same_state
 
-from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, MEMORY_DIR, PREVIOUS_CHECKPOINT_FILE
-from experiments.run.memory_segments import MEMORY_KEY, read_checkpoint
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.run.trial_checks import load_trial
+from experiments.run.trial_parts import load_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE, MEMORY_DIR, PREVIOUS_CHECKPOINT_FILE
+from experiments.trial_dir.memory_segments import MEMORY_KEY, read_checkpoint
 
 
 def test_a_late_checkpoint_writes_about_the_bytes_of_an_early_one(tmp_path, monkeypatch):

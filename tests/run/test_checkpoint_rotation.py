@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import os
 
-from experiments import storage
-from experiments.file_names import CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE
 
 SETTINGS = TrialSettings(grasp="kinematic", iterations=60, checkpoint_every=20, seed=3)
 

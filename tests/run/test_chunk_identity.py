@@ -14,14 +14,21 @@ from old_trials import as_before_manifests
 from test_trial_integrity import task_failure
 from trial_logs import same_logs
 
-from experiments import storage
 from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.batches.runner import is_complete
 from experiments.cli.main import main
-from experiments.file_names import CONFIG_FILE, LOCK_FILE, LOG_DIR, LOG_KINDS
-from experiments.log_layout import CHUNK_IDENTITY_KEY, chunk_identity, trial_identity
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import trial_identity
+from experiments.trial_dir.layout import (
+    CHUNK_IDENTITY_KEY,
+    CONFIG_FILE,
+    LOCK_FILE,
+    LOG_DIR,
+    LOG_KINDS,
+    chunk_identity,
+)
 
 TOTAL, PERIOD = 300, 100
 OWN, OTHER = 5, 6  # the seeds

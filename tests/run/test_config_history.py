@@ -10,15 +10,19 @@ from pathlib import Path
 
 import pytest
 
-from experiments.config_file import added_settings, identity_form, with_added_settings
-from experiments.log_layout import trial_identity
 from experiments.run.settings import TrialSettings
+from experiments.trial_dir.config_file import (
+    added_settings,
+    identity_form,
+    trial_identity,
+    with_added_settings,
+)
 from sim.config import WorldConfig
 from sim.vocal.config import VoiceConfig
 
 DATA = Path(__file__).parents[1] / "data"
 # A config.json as `playroom run --seed 7` wrote it at f12e6ee, before the settings declared
-# their history beside their fields (experiments/config_file.py held it in a dict then).
+# their history beside their fields (experiments/trial_dir/config_file.py held it in a dict then).
 WRITTEN = DATA / "config-seed7-written-at-f12e6ee.json"
 # The settings of config.json before the first one was added to trials already written (the
 # vocal tract, f838cfe): its parent's TrialSettings, WorldConfig and VoiceConfig.

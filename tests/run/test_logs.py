@@ -12,13 +12,18 @@ import pytest
 from old_trials import as_before_manifests
 from trial_logs import logs_of
 
-from experiments import storage
 from experiments.analysis.logs import read_batch_logs, read_log
 from experiments.analysis.results import collect
 from experiments.batches.runner import is_complete
-from experiments.file_names import LOG_DIR, LOG_README_FILE
-from experiments.log_layout import DuplicateChunkError
-from experiments.log_schema import (
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.checks import check_logs
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import LOG_DIR, LOG_README_FILE, DuplicateChunkError
+from experiments.trial_dir.log_schema import (
     GOAL_COLUMNS,
     INTEREST_COLUMNS,
     KINDS,
@@ -28,12 +33,6 @@ from experiments.log_schema import (
     WORD,
     column_names,
 )
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_checks import check_logs
-from experiments.run.trial_files import TrialError
 from learner.config import learner_preset
 
 # Short trials: a bootstrap of 10 random commands, then goals, under active babbling.
@@ -245,7 +244,7 @@ def test_an_old_layout_trial_resumes_into_the_folders(old_trial, tmp_path):
 
 
 def test_a_resume_killed_mid_move_is_finished_by_the_next(old_trial):
-    from experiments.run.old_logs import move_old_chunks
+    from experiments.trial_dir.old_logs import move_old_chunks
 
     old, new = old_trial
     config = storage.read_json(old / "config.json")

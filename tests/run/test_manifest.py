@@ -14,10 +14,16 @@ from old_trials import as_before_manifests
 from test_trial_integrity import _cli, _contents, _copy
 from trial_states import same_state
 
-from experiments import backend_record, manifest, storage
 from experiments.analysis.logs import read_log
 from experiments.batches.runner import is_complete, run_and_evaluate
-from experiments.file_names import (
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_parts import load_trial
+from experiments.trial_dir import backend_record, manifest, storage
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
     LOG_DIR,
@@ -25,12 +31,6 @@ from experiments.file_names import (
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_checks import load_trial
-from experiments.run.trial_files import TrialError
 
 SEED, TOTAL, PERIOD = 4, 300, 100
 # The project preset stores memory rows from the first iteration: every period has a segment.

@@ -1,7 +1,7 @@
-"""The memory's rows are written once, in append-only segments (experiments/run/memory_segments.py),
-and a trial still resumes bit for bit from a kill at every moment of a checkpoint period; a
-segment that is stray, missing, damaged or another trial's is ignored, or named and fallen back
-from as a damaged checkpoint is."""
+"""The memory's rows are written once, in append-only segments
+(experiments/trial_dir/memory_segments.py), and a trial still resumes bit for bit from a kill at
+every moment of a checkpoint period; a segment that is stray, missing, damaged or another trial's is
+ignored, or named and fallen back from as a damaged checkpoint is."""
 
 from __future__ import annotations
 
@@ -15,19 +15,19 @@ from pathlib import Path
 import pytest
 from trial_states import SEGMENTED, same_state
 
-from experiments import storage
 from experiments.batches.runner import is_complete
-from experiments.file_names import (
+from experiments.run.trial import run_trial
+from experiments.run.trial_parts import load_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     DAMAGED_CHECKPOINT_FILE,
     LOCK_FILE,
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.run.memory_segments import MEMORY_KEY, read_checkpoint
-from experiments.run.trial import run_trial
-from experiments.run.trial_checks import load_trial
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir.memory_segments import MEMORY_KEY, read_checkpoint
 
 TOTAL, PERIOD = SEGMENTED.iterations, SEGMENTED.checkpoint_every
 SEGMENTS = [f"rows-{start:08d}.npz" for start in range(0, TOTAL, PERIOD)]

@@ -18,22 +18,26 @@ import pytest
 import threadpoolctl
 
 import experiments
-from experiments import provenance, storage
 from experiments.cli.main import main
-from experiments.file_names import CONFIG_FILE, DAMAGED_PROVENANCE_FILE, EVAL_FILE, PROVENANCE_FILE
 from experiments.measure.for_reports import room_measures
-from experiments.provenance import (
-    bit_differences,
-    computed_on_line,
-    describe,
-    machine_record,
-    read_entries,
-    short_record,
-    source_record,
-)
 from experiments.report.batch_report import write_report
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.layout import (
+    CONFIG_FILE,
+    DAMAGED_PROVENANCE_FILE,
+    EVAL_FILE,
+    PROVENANCE_FILE,
+)
+from experiments.trial_dir.provenance import (
+    bit_differences,
+    describe,
+    machine_record,
+    short_record,
+    source_record,
+)
+from experiments.trial_dir.provenance_file import computed_on_line, read_entries
 
 SOURCE_ROOT = Path(experiments.__file__).resolve().parents[1]
 SHORT = TrialSettings(grasp="kinematic", iterations=100, seed=3, checkpoint_every=100)

@@ -1,4 +1,5 @@
-"""A trial's opening reads from top to bottom (experiments/run/trial.py, trial_opening.py): the
+"""A trial's opening reads from top to bottom (experiments/run/trial.py,
+experiments/trial_dir/opening.py): the
 trial calls each of its stages once, in order, and no module of experiments is called back by
 one it called, for a new trial and for a resume. Followed with a profiler over the calls
 between modules, from the trial's creation to its first iteration."""
@@ -19,11 +20,14 @@ ROOT = Path(experiments.__file__).resolve().parent
 # The trial's stages, in the order it calls them.
 STAGES = [
     "run.trial_config",
-    "run.trial_files",
-    "run.trial_opening",
-    "provenance",
-    "backend_record",
+    "run.trial_parts",
+    "trial_dir.opening",
+    "trial_dir.provenance_file",
+    "trial_dir.backend_record",
 ]
+
+# What every step of the opening reads and writes through: the trial directory's files.
+FILE_LAYERS = {f"trial_dir.{m}" for m in ("storage", "layout", "config_file", "manifest")}
 
 
 def _module(filename: str) -> str | None:
@@ -93,8 +97,9 @@ def test_a_trial_opens_top_to_bottom(tmp_path, resume):
     assert entered["run.trial"] == STAGES
     assert _cycle(edges) is None
     # The opening enters each of its own steps once (the disk estimate, the lock, the checks
-    # of what lies in the directory, a resume's memory segments), whatever file layers each
-    # reads through.
-    steps = [m for m in entered["run.trial_opening"] if m.startswith("run.")]
-    assert steps[:3] == ["run.estimate", "run.lock", "run.trial_checks"]
+    # of what lies in the directory: a resume's, or a new trial's litter), whatever file layers
+    # each reads through.
+    steps = [m for m in entered["trial_dir.opening"] if m not in FILE_LAYERS]
+    checks = "trial_dir.resume" if resume else "trial_dir.checks"
+    assert steps[:3] == ["run.estimate", "trial_dir.lock", checks]
     assert len(steps) == len(set(steps))

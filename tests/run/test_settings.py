@@ -9,16 +9,16 @@ import math
 
 import pytest
 
-from experiments import storage
 from experiments.analysis.logs import read_log
 from experiments.analysis.results import _eval_numbers
 from experiments.cli.main import main
-from experiments.config_file import identity_form, with_added_settings
-from experiments.file_names import CHECKPOINT_FILE, CONFIG_FILE
 from experiments.run.settings import TrialSettings, resume_settings
 from experiments.run.trial import run_trial
 from experiments.run.trial_config import full_config
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import identity_form, with_added_settings
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE
 from learner.config import LearnerConfig
 from sim.config import DEFAULT_WORLD, WorldConfig, config_from_dict, world_preset
 from sim.vocal.config import DEFAULT_VOICE, VoiceConfig

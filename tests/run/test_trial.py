@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from trial_states import same_state
 
-from experiments import storage
 from experiments.analysis.logs import read_log
 from experiments.cli.main import main
-from experiments.file_names import CHECKPOINT_FILE
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import CHECKPOINT_FILE
 from models.layout import SAMPLE_INDICES
 from sim import Playroom
 from sim.config import world_preset

@@ -10,9 +10,14 @@ import threading
 import pytest
 from trial_states import same_state
 
-from experiments import storage
 from experiments.batches.runner import run_and_evaluate
-from experiments.file_names import (
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.errors import TrialError, TrialLocked
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
@@ -20,16 +25,11 @@ from experiments.file_names import (
     LOCK_FILE,
     PREVIOUS_CHECKPOINT_FILE,
 )
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run.lock import DirectoryLock
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_files import TrialError, TrialLocked
+from experiments.trial_dir.lock import DirectoryLock
 
 PLAYROOM = [sys.executable, "-m", "experiments.cli.main"]
 HOLD_LOCK = (
-    "import sys, time; from experiments.run.lock import DirectoryLock; "
+    "import sys, time; from experiments.trial_dir.lock import DirectoryLock; "
     "DirectoryLock(sys.argv[1]).acquire(); print('held', flush=True); time.sleep(600)"
 )
 

@@ -26,7 +26,7 @@ def test_disk_and_checkpoint_writes_grow_with_the_iterations_time_faster():
     one = estimate.trial_costs(TrialSettings(iterations=100000, checkpoint_every=1000))
     two = estimate.trial_costs(TrialSettings(iterations=200000, checkpoint_every=1000))
     assert two.disk_bytes == pytest.approx(2 * one.disk_bytes, rel=0.01)
-    # Each row of memory is written once (experiments/run/memory_segments.py), not by every
+    # Each row of memory is written once (experiments/trial_dir/memory_segments.py), not by every
     # checkpoint again.
     assert two.written_bytes == pytest.approx(2 * one.written_bytes, rel=0.01)
     assert two.seconds > 2 * one.seconds  # the query searches more rows as the memory grows

@@ -12,10 +12,16 @@ import sys
 import pytest
 from trial_states import same_state
 
-from experiments import storage
 from experiments.batches.runner import is_complete, run_and_evaluate
 from experiments.cli.main import main
-from experiments.file_names import (
+from experiments.measure.evaluation import EvaluationSettings
+from experiments.measure.trial_evaluation import evaluate_trial
+from experiments.run.settings import TrialSettings
+from experiments.run.trial import run_trial
+from experiments.run.trial_parts import load_trial
+from experiments.trial_dir import storage
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     CONFIG_FILE,
     DAMAGED_CHECKPOINT_FILE,
@@ -27,12 +33,6 @@ from experiments.file_names import (
     eval_world_dir,
     manifest_name,
 )
-from experiments.measure.evaluation import EvaluationSettings
-from experiments.measure.trial_evaluation import evaluate_trial
-from experiments.run.settings import TrialSettings
-from experiments.run.trial import run_trial
-from experiments.run.trial_checks import load_trial
-from experiments.run.trial_files import TrialError
 
 SEED, TOTAL, PERIOD = 7, 300, 100
 SETTINGS = TrialSettings(iterations=TOTAL, seed=SEED, checkpoint_every=PERIOD)
@@ -134,7 +134,7 @@ def test_killed_between_the_first_log_chunk_and_its_checkpoint_resumes_to_the_sa
 
 # 2. A checkpoint carries its trial's identity ------------------------------------------------
 def test_the_identity_is_the_seed_and_the_settings_that_make_the_trial():
-    from experiments.log_layout import trial_identity
+    from experiments.trial_dir.config_file import trial_identity
 
     config = {
         "trial": {"seed": 3, "iterations": 10, "grasp": "kinematic"},
@@ -166,7 +166,7 @@ def test_a_checkpoint_of_another_trial_is_refused(base, tmp_path, capsys, settin
 
 
 def test_a_checkpoint_without_identity_is_taken_with_a_notice(base, tmp_path):
-    from experiments.log_layout import trial_identity
+    from experiments.trial_dir.config_file import trial_identity
 
     out = _copy(base, tmp_path)
     arrays, meta = storage.read_arrays(out / CHECKPOINT_FILE)

@@ -9,15 +9,15 @@ import json
 
 import pytest
 
-from experiments import storage
 from experiments.batches.spec import BatchError, BatchSpec, load_spec
 from experiments.cli.main import main
-from experiments.file_names import CONFIG_FILE, PROVENANCE_FILE
-from experiments.log_layout import trial_identity
 from experiments.run.settings import TrialSettings, resume_settings
 from experiments.run.trial import run_trial
 from experiments.run.trial_config import full_config
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import trial_identity
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import CONFIG_FILE, PROVENANCE_FILE
 from sim.vocal.diva import data
 
 

@@ -1,5 +1,5 @@
 """Trials compared whole: their newest checkpoints read with every model's rows (joined from the
-memory segments they name, experiments/run/memory_segments.py), and their logs."""
+memory segments they name, experiments/trial_dir/memory_segments.py), and their logs."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 from trial_logs import same_logs
 
-from experiments.file_names import CHECKPOINT_FILE
-from experiments.manifest import MANIFEST_KEY
-from experiments.run.memory_segments import read_checkpoint
 from experiments.run.settings import TrialSettings
+from experiments.trial_dir.layout import CHECKPOINT_FILE
+from experiments.trial_dir.manifest import MANIFEST_KEY
+from experiments.trial_dir.memory_segments import read_checkpoint
 
 # A trial whose memory grows from its first iteration (the project preset learns from its
 # bootstrap; the study's stores nothing before iteration 1000): 4 checkpoint periods.

@@ -8,7 +8,7 @@ Each backend is loaded by name and built into a room; it acts (an arm and a voic
 feedback of the room's shape); its unobserved path (the closed form, or compiled steps) gives
 what the observed, stepped dm_control path gives, to the bit; a short trial with it records what
 it declares (backend.json), which for the two backends of before the record equals what old
-trials are read with (experiments/backend_record.py `recorded_before`); the comparison's
+trials are read with (experiments/trial_dir/backend_record.py `recorded_before`); the comparison's
 grasp-rate row and the stick-reach figure show it under its own name and reach.
 """
 
@@ -26,14 +26,14 @@ import pandas as pd
 import pytest
 from scripted import Waypoint, arm_command_through
 
-from experiments import backend_record, storage
 from experiments.analysis.room_measures import RoomMeasures
-from experiments.file_names import BACKEND_FILE, CONFIG_FILE
 from experiments.measure.stick import grasp_rates
 from experiments.report import stick_reach
 from experiments.report.comparison import _grasp_rate_row
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import Trial, run_trial
+from experiments.trial_dir import backend_record, storage
+from experiments.trial_dir.layout import BACKEND_FILE, CONFIG_FILE
 from models.layout import ARM_DIM, N_STEPS, SENSORY_DIM, TRACKED_OBJECTS, VOICE_DIM
 from sim import Playroom
 from sim import events as ev

@@ -11,7 +11,7 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from experiments.config_file import with_added_settings
+from experiments.trial_dir.config_file import with_added_settings
 from sim import Playroom
 from sim import events as ev
 from sim.arm_servo import ArmServo

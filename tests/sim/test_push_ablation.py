@@ -10,7 +10,7 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from experiments.config_file import identity_form, with_added_settings
+from experiments.trial_dir.config_file import identity_form, with_added_settings
 from sim import Playroom
 from sim import events as ev
 from sim.config import SETTLE_PHYSICS_STEPS, world_preset

@@ -14,7 +14,7 @@ from experiments.batches.spec import BatchSpec
 from experiments.cli.args import RUN_DEFAULTS
 from experiments.cli.main import build_parser
 from experiments.run.settings import TrialSettings
-from experiments.run.trial_files import TrialError
+from experiments.trial_dir.errors import TrialError
 from learner.agent import Agent
 from learner.config import BABBLING_MODES, learner_preset
 from models.presets import DEFAULT_PRESET, PRESETS
@@ -88,9 +88,9 @@ def test_a_trial_refuses_a_backend_the_registry_does_not_know():
 def test_a_third_backend_is_its_module_and_one_registry_line(monkeypatch, tmp_path):
     """Registered by one line (tests/third_backend.py is its module), a backend runs a trial,
     which records what it declares; the estimate and the room's paths need nothing else."""
-    from experiments import backend_record, storage
     from experiments.run import estimate
     from experiments.run.trial import run_trial
+    from experiments.trial_dir import backend_record, storage
     from sim.grasping.registry import REGISTRY
 
     monkeypatch.setitem(REGISTRY, "long_reach", "third_backend:LongReachGrasp")

@@ -158,10 +158,10 @@ def test_the_study_bootstrap_tosses_coins_learns_nothing_and_waits_for_two_outco
 
 
 def test_a_trial_can_switch_one_departure_back(tmp_path):
-    from experiments import storage
     from experiments.run.settings import TrialSettings
     from experiments.run.trial import run_trial
-    from experiments.run.trial_files import TrialError
+    from experiments.trial_dir import storage
+    from experiments.trial_dir.errors import TrialError
 
     overrides = {"learner": {"exploration_sigma": 0.05}, "world": {"dmp": "project"}}
     settings = TrialSettings(iterations=5, overrides=overrides)

@@ -21,7 +21,7 @@ What an eval world changes, and what it keeps:
 A trial is never evaluated twice in one world: an eval world equal to the trial's own (same
 backend, and every switch that backend reads equal: `own_world`) is its own evaluation,
 eval.json in the trial directory, which `playroom eval DIR` writes; the other worlds' are
-written beside it, in `eval-in-NAME/` (file_names.eval_world_dir).
+written beside it, in `eval-in-NAME/` (layout.eval_world_dir).
 
 Plain functions of config.json's dicts and the world's settings dataclass: readers of results
 use them without a room.
@@ -105,7 +105,7 @@ def _preset(config: dict) -> str:
 
 def world_settings(config: dict, name: str) -> tuple[str, dict]:
     """(grasp, world settings as config.json holds them) of eval world `name` for the trial of
-    `config` (its config.json, added settings filled in: experiments/config_file.py)."""
+    `config` (its config.json, added settings filled in: experiments/trial_dir/config_file.py)."""
     if name not in EVAL_WORLDS:
         raise EvalWorldError(f"unknown eval world {name!r}: one of {', '.join(EVAL_WORLDS)}")
     world = EVAL_WORLDS[name]

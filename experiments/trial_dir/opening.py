@@ -1,12 +1,13 @@
 """A trial directory opened for a run, started or resumed, decided here in one place and read
-from top to bottom (`open_trial_directory`): the path and the disk checked, a directory of
-something else refused, the directory locked, a trial's refused without `resume` and with
-another configuration, a new trial's config.json written, and a resumed trial's newest usable
-checkpoint restored (its logs checked first and the work past it dropped:
-experiments/run/trial_checks.py) and the trial extended if more iterations are asked for.
-What the run starts from comes back whole (`OpenedTrial`): `Trial` (experiments/run/trial.py)
-only takes it. Called once the trial's room and agent have been built from its typed settings
-(a config that builds none leaves the directory as it was); config.json is read once here."""
+from top to bottom (`open_trial_directory`): the path and the disk checked (the disk by the
+run's estimate, experiments/run/estimate.py), a directory of something else refused, the
+directory locked, a trial's refused without `resume` and with another configuration, a new
+trial's config.json written, and a resumed trial's newest usable checkpoint restored (its logs
+checked first and the work past it dropped: resume.py) and the trial extended if more
+iterations are asked for. What the run starts from comes back whole (`OpenedTrial`): `Trial`
+(experiments/run/trial.py) only takes it. Called once the trial's room and agent have been
+built from its typed settings (a config that builds none leaves the directory as it was);
+config.json is read once here."""
 
 from __future__ import annotations
 
@@ -14,36 +15,44 @@ import contextlib
 import errno
 import os
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Generic
 
 import numpy as np
 
-from experiments import manifest, storage
-from experiments.config_file import UnknownSettingError, check_known, with_added_settings
-from experiments.file_names import (
+from experiments.trial_dir import manifest, memory_segments, storage
+from experiments.trial_dir.checkpoint import A, Build, R
+from experiments.trial_dir.checks import is_litter, remove_litter
+from experiments.trial_dir.config_file import (
+    EXTENSIBLE,
+    UnknownSettingError,
+    check_known,
+    trial_identity,
+    with_added_settings,
+)
+from experiments.trial_dir.errors import TrialError, TrialLocked
+from experiments.trial_dir.layout import (
     CONFIG_FILE,
     LOCK_FILE,
     LOG_DIR,
+    LOG_README,
     LOG_README_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
+    chunk_paths,
+    source_of,
 )
-from experiments.log_layout import EXTENSIBLE, chunk_paths, source_of, trial_identity
-from experiments.run import estimate, memory_segments
-from experiments.run.lock import DirectoryLock, DirectoryLocked
-from experiments.run.settings import TrialSettings
-from experiments.run.trial_checks import Build, is_litter, prepare_resume, remove_litter
-from experiments.run.trial_files import LOG_README, TrialError, TrialLocked
-from learner.agent import Agent
-from sim import Playroom
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.resume import prepare_resume
 
 # What a trial counts as it runs (its checkpoints keep them; `playroom run` prints them).
 COUNTS = ("tool_uses", "words_recognised", "diverged", "stick_returns")
 
 
 @dataclass
-class OpenedTrial:
+class OpenedTrial(Generic[A, R]):
     """A trial directory ready for its run, locked (`lock`), and what the run starts from:
     the agent and room (restored, or at iteration 0), where the checkpoint left the trial, the
     files its next checkpoint records, and one line per thing the opening did or noticed."""
@@ -52,15 +61,15 @@ class OpenedTrial:
     lock: DirectoryLock
     identity: dict  # carried by every checkpoint and log chunk
     source: dict  # first in every log row
-    agent: Agent
-    room: Playroom
+    agent: A
+    room: R
     best_word_distance: np.ndarray  # to each word, the best reached so far
     counts: dict[str, int]  # of COUNTS
     iteration: int = 0
     memory: memory_segments.MemoryOnDisk = field(
         default_factory=lambda: memory_segments.MemoryOnDisk({}, None, 0)
     )
-    # The newest manifest file (experiments/manifest.py), the manifest of the checkpoint
+    # The newest manifest file (experiments/trial_dir/manifest.py), the manifest of the checkpoint
     # restored, and the data files written since it, which the next checkpoint records.
     manifest_pointer: dict | None = None
     recorded: manifest.Manifest | None = None
@@ -70,19 +79,23 @@ class OpenedTrial:
 
 def open_trial_directory(
     out_dir: str | os.PathLike,
-    settings: TrialSettings,
     config: dict,
-    parts: tuple[Agent, Playroom],
-    build: Build,
+    parts: tuple[A, R],
+    build: Build[A, R],
     resume: bool,
-) -> OpenedTrial:
-    """The directory made ready for the run of `settings` (`config`, its config.json form;
-    `parts`, the agent and room built from them at iteration 0: the run's, or those a resume
-    restores into; `build` builds others if a restore fails half-way). TrialError (one line)
-    if the directory cannot be used; the lock is held only if the opening succeeds."""
+    words: int,
+    fits: Callable[[Path], str | None],
+) -> OpenedTrial[A, R]:
+    """The directory made ready for the run of the trial of `config` (its config.json form;
+    `parts`, the agent and room built from it at iteration 0: the run's, or those a resume
+    restores into; `build` builds others if a restore fails half-way; `words`, how many words
+    its voice has, the best distance to each unreached at first; `fits`, the run's check that
+    the trial fits on the directory's disk, before anything is written: TrialError if not, or
+    a line to tell the user). TrialError (one line) if the directory cannot be used; the lock
+    is held only if the opening succeeds."""
     d = trial_path(out_dir)
     notices = []
-    line = estimate.check_fits(d, settings, resume)  # before anything is written
+    line = fits(d)  # before anything is written
     if line is not None:
         notices.append(line)
     _refuse_foreign_path(d)
@@ -93,7 +106,7 @@ def open_trial_directory(
     except OSError as exc:
         raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
     try:
-        opened = _opened(d, lock, config, parts, build, resume)
+        opened = _opened(d, lock, config, parts, build, resume, words)
     except BaseException:
         lock.release()
         raise
@@ -105,10 +118,11 @@ def _opened(
     d: Path,
     lock: DirectoryLock,
     config: dict,
-    parts: tuple[Agent, Playroom],
-    build: Build,
+    parts: tuple[A, R],
+    build: Build[A, R],
     resume: bool,
-) -> OpenedTrial:
+    words: int,
+) -> OpenedTrial[A, R]:
     config_path = d / CONFIG_FILE
     held = None
     if config_path.exists():
@@ -130,9 +144,9 @@ def _opened(
     restored = prepare_resume(d, config, parts, build, notices) if resume else None
     if restored is None:
         agent, room = parts
-        unreached = np.full(len(room.vocal_tract.config.words), np.inf)
+        unreached = np.full(words, np.inf)
         counts = dict.fromkeys(COUNTS, 0)
-        opened = OpenedTrial(
+        opened: OpenedTrial[A, R] = OpenedTrial(
             d, lock, identity, source, agent, room, unreached, counts, notices=notices
         )
     else:

@@ -6,7 +6,7 @@ length, and the bytes written over a trial with the square of it (416 MB
 checkpoints by iteration 681000, one every 1000 iterations). So the rows live apart, in
 append-only segments, and a checkpoint writes only those stored since the one before it:
 
-- `memory/rows-NNNNNNNN.npz` (experiments/file_names.py names it): the rows every model
+- `memory/rows-NNNNNNNN.npz` (experiments/trial_dir/layout.py names it): the rows every model
   stored over the checkpoint period that starts at iteration NNNNNNNN, under the keys of
   Agent.state_dict (`model{number}.motor`, `model{number}.key`); in its metadata, the trial's
   identity (as log chunks and checkpoints carry it), the period's first and last iteration,
@@ -21,7 +21,7 @@ Crash safety, a run killed (SIGKILL) at any moment resuming bit for bit. A segme
 atomically (storage.write_arrays), after the period's log chunks and before the checkpoint
 that names it, and never changes once a usable checkpoint names it (a run writes only the
 segment of the period after the checkpoint it resumed from):
-- killed while writing it: its temporary file is litter (trial_checks.remove_litter);
+- killed while writing it: its temporary file is litter (checks.remove_litter);
 - killed after it, before the checkpoint: the newest checkpoint is the period's start, and the
   segment of that period lies beyond it. A resume deletes such segments with the logs past the
   checkpoint (`drop_segments_past`), and the run writes the same one again; a reader that does
@@ -43,13 +43,13 @@ from __future__ import annotations
 import dataclasses
 import re
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
-from experiments import manifest, storage
-from experiments.file_names import MEMORY_DIR, MEMORY_SEGMENT_PREFIX, memory_segment_name
-from experiments.log_layout import identity_text
-from learner.agent import Agent
+from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.config_file import identity_text
+from experiments.trial_dir.layout import MEMORY_DIR, MEMORY_SEGMENT_PREFIX, memory_segment_name
 
 # A checkpoint's keys for the agent's state: AGENT + a key of Agent.state_dict.
 AGENT = "agent/"
@@ -57,6 +57,15 @@ AGENT = "agent/"
 MEMORY_KEY = "memory"
 _PARTS = ("motor", "key")  # each model's arrays of rows, as Agent.state_dict names them
 _SEGMENT = re.compile(re.escape(MEMORY_SEGMENT_PREFIX) + r"(?P<start>[0-9]{8,})\.npz")
+
+
+class Memories(Protocol):
+    """What stores a trial's memories (learner.agent.Agent): each model's rows, and those of
+    them stored from a row on."""
+
+    def memory_sizes(self) -> dict[int, int]: ...
+
+    def memory_rows(self, rows_from: dict[int, int]) -> dict[str, np.ndarray]: ...
 
 
 class ForeignSegmentError(storage.CorruptFileError):
@@ -88,7 +97,7 @@ def on_disk(meta: dict) -> MemoryOnDisk:
 
 
 def write_segment(
-    trial_dir: Path, agent: Agent, held: MemoryOnDisk, iteration: int, identity: dict
+    trial_dir: Path, agent: Memories, held: MemoryOnDisk, iteration: int, identity: dict
 ) -> MemoryOnDisk:
     """Write the rows `agent` stored since `held` (its trial's checkpoint before this one, at
     `held.iteration`) as one segment, atomically; returns what the segments then hold, for the

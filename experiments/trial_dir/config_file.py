@@ -1,4 +1,6 @@
-"""config.json across versions: settings added after trials were written.
+"""config.json across versions, and the identity of the trial it makes: settings added after
+trials were written, and what a trial's checkpoints, log chunks, memory segments and evaluations
+carry of it (`trial_identity`), so that a file of another trial is told apart.
 
 A trial's config.json holds every setting it ran with. A setting added later (the vocal tract,
 `voice`) is absent from older trials, which ran with the value the setting declares beside its
@@ -19,6 +21,8 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import hashlib
+import json
 
 from sim.config import BEFORE, WorldConfig
 from sim.vocal.config import VoiceConfig
@@ -93,3 +97,33 @@ def check_known(config: dict, path: object) -> None:
                     f"{path} has an unknown setting {section}.{unknown[0]}, which no version of "
                     "the project writes: remove it (an edit by hand?)"
                 )
+
+
+# Settings a resume may change: a trial can be extended to more iterations.
+EXTENSIBLE = ("trial.iterations",)
+# What an identity leaves out of its trial's config: the settings a resume may change, and the
+# package version. The version says which code wrote config.json, not which trial it is; in the
+# identity it would orphan every checkpoint at each release (whether a trial may be resumed by
+# another version is for the config comparison on resume to say).
+_NOT_IDENTITY = (*EXTENSIBLE, "package_version")
+
+
+def trial_identity(config: dict) -> dict:
+    """What a trial's checkpoints and log chunks carry of it: the seed, and a hash of the
+    trial's config without the settings that are not the trial's identity (_NOT_IDENTITY)."""
+    kept = identity_form(config)  # a copy, as older trials' configs would read
+    for key in _NOT_IDENTITY:
+        *parents, last = key.split(".")
+        node = kept
+        for parent in parents:
+            node = node.get(parent, {})
+        node.pop(last, None)
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    return {"seed": config["trial"]["seed"], "config": digest}
+
+
+def identity_text(identity: object) -> str:
+    """An identity as messages show it: "seed 5, config 0123456789ab"."""
+    found = identity if isinstance(identity, dict) else {}
+    return f"seed {found.get('seed', '?')}, config {found.get('config', '?')}"

@@ -28,9 +28,9 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from experiments import manifest, storage
-from experiments.config_file import with_added_settings
-from experiments.file_names import BACKEND_FILE
+from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.layout import BACKEND_FILE
 from models import playroom_xml
 
 # What a record holds: the backend's name, its reach (m), then its capabilities.

@@ -15,7 +15,7 @@ import socket
 import time
 from pathlib import Path
 
-from experiments.file_names import LOCK_FILE
+from experiments.trial_dir.layout import LOCK_FILE
 
 # How often a waiting writer tries again (s).
 POLL_S = 0.5

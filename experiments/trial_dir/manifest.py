@@ -8,12 +8,12 @@ segments (`memory/rows-*.npz`) and `backend.json`. Checkpoints are not listed: a
 zip archive whose every member carries its own CRC-32, which NumPy's reader checks, and the
 previous checkpoint is kept beside the newest. config.json is not listed either: a resume
 rewrites it when the trial is extended, and its content is checked otherwise (each
-checkpoint, chunk and segment carries a hash of it: experiments/log_layout.py `trial_identity`).
+checkpoint, chunk and segment carries a hash of it: config_file.py `trial_identity`).
 An evaluation's tables are listed in its own eval.json (`EVAL_FILES_KEY`), which is written
-after them (experiments/storage.py `write_files`) and records its own checksum and trial
-(experiments/eval_record.py: written after the last checkpoint, no manifest can list it).
+after them (storage.py `write_files`) and records its own checksum and trial
+(experiments/trial_dir/eval_record.py: written after the last checkpoint, no manifest can list it).
 
-How it is kept: append-only, as the memory is (experiments/run/memory_segments.py), so that
+How it is kept: append-only, as the memory is (experiments/trial_dir/memory_segments.py), so that
 a checkpoint's cost does not grow with the trial. Each checkpoint writes the entries of the
 files written since the checkpoint before it into a small JSON file of its own,
 `manifest/files-NNNNNNNN.json` (NNNNNNNN the iteration of the checkpoint), which names the
@@ -40,8 +40,8 @@ import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
-from experiments import storage
-from experiments.file_names import (
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
     LOG_DIR,
@@ -77,7 +77,7 @@ class UncheckedTrialWarning(UserWarning):
 
 class UncheckedEvaluationWarning(UncheckedTrialWarning):
     """An evaluation written before eval.json recorded its checksum and its trial was read: it
-    could not be checked (experiments/eval_record.py)."""
+    could not be checked (experiments/trial_dir/eval_record.py)."""
 
     what = (
         "evaluated before eval.json recorded its checksum and its trial, read unchecked "

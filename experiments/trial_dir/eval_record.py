@@ -1,5 +1,5 @@
 """An evaluation's eval.json, recorded so that a reader can trust it as it trusts a trial's
-data files (experiments/manifest.py): its own checksum, and the trial it belongs to.
+data files (experiments/trial_dir/manifest.py): its own checksum, and the trial it belongs to.
 
 eval.json vouches for its tables (it lists their sizes and SHA-256: manifest.EVAL_FILES_KEY),
 but nothing else vouches for it: it is written after the trial's last checkpoint (a trial's
@@ -11,7 +11,7 @@ any time later), so no checkpoint's manifest can record it. So it records itself
   out, writes the rest again the same way and compares, and checks that the file's bytes are
   the very text the writer made of both: a flipped bit anywhere, in a number, in the checksum
   itself or in a space, is refused, so the check needs nothing outside the file.
-- `IDENTITY_KEY`: the identity of the trial evaluated (experiments/log_layout.py
+- `IDENTITY_KEY`: the identity of the trial evaluated (experiments/trial_dir/config_file.py
   `trial_identity`, as its checkpoints and log chunks carry it), beside the `seed` and `grasp`
   eval.json has always held. A reader compares all three with the trial's config.json: another
   trial's evaluation copied in whole, tables and all, is intact but not this trial's.
@@ -30,9 +30,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments import manifest, storage
-from experiments.file_names import EVAL_FILE, EVAL_WORLD_PREFIX
-from experiments.log_layout import identity_text, trial_identity
+from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.config_file import identity_text, trial_identity
+from experiments.trial_dir.layout import EVAL_FILE, EVAL_WORLD_PREFIX
 
 # eval.json's entry of its own checksum ([size, sha256] of the text of the other entries).
 CHECKSUM_KEY = "checksum"

@@ -3,7 +3,7 @@
 Trials written before each kind of log had its folder hold `log/iterations-NNNNNNNN.parquet`
 and `log/words-NNNNNNNN.parquet` side by side, without the columns rows carry since (their
 source: trial, seed, backend, voice; the learner's goal, outcome and interests). Every reader
-reads them as they are (experiments/log_layout.py); a resume, which writes new chunks
+reads them as they are (experiments/trial_dir/layout.py); a resume, which writes new chunks
 into the folders, first brings the old ones there too, so that a kind's folder reads as one
 table (`pd.read_parquet("TRIAL/log/iterations")`).
 
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments import storage
-from experiments.log_layout import chunk_path, old_chunks, source_of
-from experiments.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
+from experiments.trial_dir import storage
+from experiments.trial_dir.layout import chunk_path, old_chunks, source_of
+from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 
 
 def move_old_chunks(trial_dir: Path, config: dict) -> int:

@@ -1,0 +1,146 @@
+"""A trial's parts and rows: the agent and room of its iteration 0, built from its typed
+settings or from its config.json (`trial_parts`, `fresh_trial_parts`), and the row of the
+iterations log each iteration makes (`log_row`, `learner_values`), whose columns
+experiments/trial_dir/log_schema.py declares.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.checkpoint import restore_newest
+from experiments.trial_dir.checks import check_files
+from experiments.trial_dir.config_file import UnknownSettingError, check_known, with_added_settings
+from experiments.trial_dir.errors import TrialConfigError, TrialError
+from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE, PREVIOUS_CHECKPOINT_FILE
+from experiments.trial_dir.log_schema import (
+    CAREGIVER_SAID,
+    DIVERGED,
+    EMPTY_ROW,
+    ITERATION,
+    MODEL,
+    MOTOR_SPACE,
+    STICK_DISTANCE,
+    STICK_GRASPED,
+    STICK_MOVED_BY,
+    STICK_RETURNED,
+    WORD_RECOGNISED,
+    moved_by,
+)
+from learner.agent import Agent, Proposal
+from learner.config import LearnerConfig
+from models.layout import BLOCK_DIM, context_indices
+from sim import Playroom
+from sim import events as ev
+from sim.config import WorldConfig, config_from_dict
+from sim.vocal.config import VoiceConfig
+
+_NO_BLOCK = np.full(BLOCK_DIM, np.nan)
+
+
+# The agent's random generator is seeded apart from the room's, from the same trial seed.
+AGENT_STREAM = 1
+
+
+def log_row(iteration: int, proposal, feedback, context: np.ndarray) -> dict:
+    """One row of the iterations log: what was tried, in what context (10,), and what happened.
+    `stick_distance` is the handle's distance from the arm's base before the movement (m)."""
+    x, y = context_indices("stick")
+    row = dict(EMPTY_ROW)  # every event column, as if nothing happened
+    row[ITERATION] = iteration
+    row[MOTOR_SPACE] = proposal.motor_space
+    row[MODEL] = -1 if proposal.model is None else int(proposal.model)
+    row[STICK_DISTANCE] = float(np.hypot(context[x], context[y]))
+    for e in feedback.events:
+        if e.kind == ev.STICK_GRASPED:
+            row[STICK_GRASPED] = True
+        elif e.kind == ev.STICK_MOVED:
+            row[STICK_MOVED_BY] = e.by
+        elif e.kind == ev.TOY_MOVED:
+            row[moved_by(e.obj)] = e.by
+        elif e.kind == ev.WORD_RECOGNISED:
+            row[WORD_RECOGNISED] = e.word
+        elif e.kind == ev.CAREGIVER_SAID:
+            row[CAREGIVER_SAID] = e.word
+        elif e.kind == ev.DIVERGED:
+            row[DIVERGED] = True
+        elif e.kind == ev.STICK_RETURNED:
+            row[STICK_RETURNED] = True
+    return row
+
+
+def learner_values(
+    proposal: Proposal, reached: np.ndarray | None, interests: np.ndarray
+) -> np.ndarray:
+    """The learner's columns of an iteration's row (log_schema.LEARNER_COLUMNS), (30,): the goal
+    (NaN without one: the bootstrap's random motor babbling), the outcome in the goal's block
+    (`Agent.outcome`, NaN without a model) and each model's interest when the model was
+    chosen (`Agent.interests`, read before the iteration's attempt)."""
+    return np.concatenate(
+        (
+            _NO_BLOCK if proposal.goal is None else proposal.goal,
+            _NO_BLOCK if reached is None else reached,
+            interests,
+        )
+    )
+
+
+def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
+    """The agent and room of a trial's iteration 0, as its config (config.json's form) makes
+    them. TrialConfigError (one line) for a config that makes none: a config.json edited by
+    hand, or written before the configs checked their settings."""
+    try:
+        settings = config["trial"]
+        return trial_parts(
+            settings["grasp"],
+            settings["seed"],
+            config_from_dict(WorldConfig, config["world"]),
+            config_from_dict(VoiceConfig, config["voice"]),
+            LearnerConfig.from_dict(config["learner"]),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
+
+
+def trial_parts(
+    grasp: str, seed: int, world: WorldConfig, voice: VoiceConfig, learner: LearnerConfig
+) -> tuple[Agent, Playroom]:
+    """The agent and room of a trial's iteration 0 from its typed configs."""
+    room = Playroom(grasp=grasp, seed=seed, config=world, voice=voice)
+    agent = Agent(learner, np.random.default_rng([seed, AGENT_STREAM]))
+    return agent, room
+
+
+def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
+    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta).
+    TrialError unless its newest checkpoint is its own and readable, and its logs up to it,
+    its memory segments and backend.json whole and as its manifest recorded them: what is
+    derived from it (an evaluation, a report) would not be the trial's."""
+    trial_dir = Path(trial_dir)
+    if not (trial_dir / CONFIG_FILE).exists():
+        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
+        raise TrialError(f"{trial_dir} has no checkpoint yet")
+    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+    try:
+        check_known(config, trial_dir / CONFIG_FILE)
+    except UnknownSettingError as exc:
+        raise TrialError(str(exc)) from None
+    agent, room, meta, fallback = restore_newest(
+        trial_dir, config, None, lambda: fresh_trial_parts(config)
+    )
+    if fallback is not None:
+        # Only the resume may fall back: it rewrites the logs past the previous checkpoint.
+        raise TrialError(
+            f"{fallback}; `playroom run --out {trial_dir} --resume` continues the trial from "
+            f"{PREVIOUS_CHECKPOINT_FILE} (iteration {meta['iteration']}), then evaluate it"
+        )
+    if meta["iteration"] == 0:
+        raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
+    if check_files(trial_dir, meta, config) is None:
+        manifest.warn_unchecked(trial_dir)
+    return config, agent, room, meta

@@ -1,0 +1,99 @@
+"""What a resume starts from: the newest usable checkpoint of a trial, restored, its logs
+checked whole (checks.py) before anything is changed; then what a killed run left is put
+right (a damaged newest checkpoint kept aside, the litter of killed writers removed, old logs
+moved into their folders) and the work past the checkpoint dropped, which the run writes again.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from experiments.trial_dir import manifest, memory_segments
+from experiments.trial_dir.checkpoint import A, Build, R, restore_newest
+from experiments.trial_dir.checks import (
+    check_logs,
+    checked_chunks,
+    recorded_manifest,
+    remove_litter,
+)
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.layout import (
+    CHECKPOINT_FILE,
+    DAMAGED_CHECKPOINT_FILE,
+    LOG_KINDS,
+    PREVIOUS_CHECKPOINT_FILE,
+)
+from experiments.trial_dir.old_logs import move_old_chunks
+
+
+def prepare_resume(
+    trial_dir: Path, config: dict, parts: tuple[A, R], build: Build[A, R], notices: list[str]
+) -> tuple[A, R, dict, manifest.Manifest | None] | None:
+    """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
+    checkpoint from before manifests) of the newest usable checkpoint, restored into `parts`
+    (fresh ones `build` builds where a restore fails half-way),
+    whose logs are whole and as recorded, or None to start from iteration 0 (no checkpoint and
+    no logs yet). Everything is checked before anything is changed; then a damaged newest
+    checkpoint is kept as checkpoint.damaged.npz, the litter of killed writers removed, old
+    logs moved into their folders and the work past the checkpoint (log chunks, memory
+    segments, manifest files) dropped: the run writes it again. Appends to `notices` one line
+    per thing done or noticed. TrialError if the trial cannot be resumed (the message says why
+    and what can be done)."""
+    newest = trial_dir / CHECKPOINT_FILE
+    if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
+        # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
+        # run/trial.py): logs without one are a trial whose checkpoints were lost.
+        chunks = [p for kind in LOG_KINDS for p in checked_chunks(trial_dir, kind).values()]
+        if chunks:
+            raise TrialError(
+                f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint "
+                f"({CHECKPOINT_FILE} and {PREVIOUS_CHECKPOINT_FILE} are missing): resuming "
+                "would restart it from iteration 0 and delete its logs; refusing. Restore the "
+                "checkpoints, or run the trial again from scratch into a new directory"
+            )
+        notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
+        restored = None
+    else:
+        agent, room, meta, fallback = restore_newest(trial_dir, config, parts, build)
+        recorded = recorded_manifest(trial_dir, meta)
+        check_logs(trial_dir, int(meta["iteration"]), config, recorded)
+        restored = agent, room, meta, recorded
+        if "identity" not in meta:
+            notices.append(
+                "the checkpoint predates trial identities (no seed or config hash in it): "
+                "taken as this trial's; the next checkpoint carries one"
+            )
+        if fallback is not None:
+            kept = ""
+            if newest.exists():  # damaged, not missing: kept for whoever looks into it
+                os.replace(newest, trial_dir / DAMAGED_CHECKPOINT_FILE)
+                kept = f" (the damaged one is kept as {DAMAGED_CHECKPOINT_FILE})"
+            notices.append(
+                f"{fallback}; resumed from the previous checkpoint ({PREVIOUS_CHECKPOINT_FILE}), "
+                f"at iteration {meta['iteration']}{kept}"
+            )
+    litter = remove_litter(trial_dir)
+    if litter:
+        notices.append(
+            f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
+        )
+    moved = move_old_chunks(trial_dir, config)
+    if moved:
+        notices.append(
+            f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
+            "log/words-*.parquet) into log/iterations/ and log/words/"
+        )
+    _drop_work_past(trial_dir, 0 if restored is None else int(restored[2]["iteration"]))
+    return restored
+
+
+def _drop_work_past(trial_dir: Path, iteration: int) -> None:
+    """Delete what was written past the checkpoint at `iteration` (the lost work's log chunks,
+    memory segments and manifest files), which the resumed run writes again."""
+    for kind in LOG_KINDS:
+        for start, chunk in checked_chunks(trial_dir, kind).items():
+            if start >= iteration:
+                chunk.unlink()
+    memory_segments.drop_segments_past(trial_dir, iteration)
+    manifest.drop_past(trial_dir, iteration)
