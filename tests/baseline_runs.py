@@ -9,9 +9,10 @@ import numpy as np
 from experiments.baseline.settings import BaselineSettings, run_name, summary_config, trial_config
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
-from experiments.measure.trial_evaluation import evaluation_files, measured
+from experiments.measure.trial_evaluation import measured
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import storage
+from experiments.trial_dir.evaluation import evaluation_files
 from experiments.trial_dir.layout import BASELINE_FILE
 
 

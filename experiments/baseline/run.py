@@ -35,9 +35,10 @@ from experiments.baseline.settings import (
 )
 from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
-from experiments.measure.trial_evaluation import evaluation_files, measured
+from experiments.measure.trial_evaluation import measured
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import manifest, provenance, storage
+from experiments.trial_dir.evaluation import evaluation_files
 from experiments.trial_dir.layout import BASELINE_FILE, EVAL_FILE, TRAINING_FILE
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from sim.config import config_from_dict

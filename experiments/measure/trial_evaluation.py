@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 
@@ -29,21 +28,14 @@ from experiments.measure.study_measure import (
     StudyMeasureSettings,
     study_tests_of,
 )
-from experiments.run.trial_parts import fresh_trial_parts, load_trial
-from experiments.trial_dir import eval_record, manifest, provenance, storage
-from experiments.trial_dir.checks import remove_litter
-from experiments.trial_dir.errors import TrialError, TrialLocked
+from experiments.run.trial_parts import fresh_trial_parts
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.eval_record import SCENES_KEY
 from experiments.trial_dir.eval_worlds import OWN, EvalWorldError, own_world, world_record
-from experiments.trial_dir.layout import (
-    COMPETENCE_FILE,
-    CONFIG_FILE,
-    EVAL_FILE,
-    STUDY_TESTS_FILE,
-    VOCAL_FILE,
-    eval_world_dir,
-)
-from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.evaluation import Evaluation
+from experiments.trial_dir.reading import TrialReading
+from experiments.trial_dir.writing import open_for_evaluation
 from sim import Playroom
 
 
@@ -60,34 +52,21 @@ def evaluate_trial(
     another process writes into (named). The temporary files of killed writers are removed
     first; `notify` is told their names.
 
-    `world`: an eval world's name (experiments/trial_dir/eval_worlds.py) tests the final agent there
-    and writes into `eval-in-<world>/` instead, the trial's own files untouched; an eval world
-    equal to the trial's own is its own evaluation (`notify` is told so)."""
+    `world`: an eval world's name (experiments/trial_dir/eval_worlds.py) tests the final agent
+    there and writes into `eval-in-<world>/` instead, the trial's own files untouched; an eval
+    world equal to the trial's own is its own evaluation (`notify` is told so)."""
     settings = settings or EvaluationSettings()
-    trial_dir = Path(trial_dir)
-    if not (trial_dir / CONFIG_FILE).is_file():  # the lock would make the folder
-        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    # Evaluation writes into the trial directory: one writer at a time, as for the trial. Taken
-    # before the trial is read: a live writer's files are caught mid-change (its checkpoint
-    # between two renames), and it is the writer that must be named.
+    # Evaluation writes into the trial directory: one writer at a time, as for the trial.
+    writer = open_for_evaluation(trial_dir)
     try:
-        lock = DirectoryLock(trial_dir).acquire()
-    except DirectoryLocked as exc:
-        raise TrialLocked(str(exc)) from None
-    except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
-        raise TrialError(f"cannot write into {trial_dir}: {storage.reason(exc)}") from None
-    try:
-        config, agent, room, meta = load_trial(trial_dir)
-        litter = remove_litter(trial_dir)  # under the lock: their writers are dead
+        config, agent, room, meta = writer.trial.restored(fresh_trial_parts)
+        litter = writer.remove_litter()
         if litter and notify is not None:
             notify(
                 f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
             )
-        out_dir, room = _where_tested(trial_dir, config, room, world, notify)
-        try:  # before minutes of tests whose results could not be kept
-            storage.check_writable(out_dir)
-        except OSError as exc:
-            raise TrialError(f"cannot write into {out_dir}: {storage.reason(exc)}") from None
+        evaluation, room = _where_tested(writer.trial, config, room, world, notify)
+        writer.check_writable(evaluation)  # before minutes of tests whose results could not be kept
         summary, tables = measured(
             LearnerActor(agent),
             StudyLearnerActor(agent),
@@ -98,41 +77,40 @@ def evaluate_trial(
             int(meta["iteration"]),
             progress,
         )
-        if out_dir != trial_dir:
+        if evaluation.folder != writer.trial.dir:
             summary["eval_world"] = world_record(config, world)
-        files = evaluation_files(summary, tables, config)
-        storage.write_files(out_dir, files)
+        writer.write(evaluation, summary, tables, config)
     finally:
-        lock.release()
+        writer.close()
     return summary
 
 
 def _where_tested(
-    trial_dir: Path,
+    trial: TrialReading,
     config: dict,
     room: Playroom,
     world: str,
     notify: Callable[[str], None] | None,
-) -> tuple[Path, Playroom]:
-    """(the folder the evaluation is written into, the room it tests in): the trial
-    directory and the room restored with the trial for its own world, else `eval-in-<world>/`
-    and a fresh room of that world, built from the trial's config as the trial's own room is
-    (its seed, voice and every setting but the backend and its switches)."""
+) -> tuple[Evaluation, Playroom]:
+    """(the evaluation written, the room it tests in): the trial's own, and the room restored
+    with the trial, for its own world, else its evaluation in `eval-in-<world>/` and a fresh
+    room of that world, built from the trial's config as the trial's own room is (its seed,
+    voice and every setting but the backend and its switches)."""
     try:
         own = world == OWN or own_world(config, world)
     except EvalWorldError as exc:
-        raise TrialError(f"{trial_dir}: {exc}") from None
+        raise TrialError(f"{trial.dir}: {exc}") from None
     if own:
         if world != OWN and notify is not None:
             notify(
-                f"{trial_dir} learned in the {world} world: its evaluation there is its own, "
+                f"{trial.dir} learned in the {world} world: its evaluation there is its own, "
                 "eval.json in the trial directory (one evaluation per world)"
             )
-        return trial_dir, room
+        return trial.evaluation(), room
     tested = world_record(config, world)
-    trial = {**config["trial"], "grasp": tested["grasp"]}
-    _, tested_room = fresh_trial_parts({**config, "trial": trial, "world": tested["world"]})
-    return trial_dir / eval_world_dir(world), tested_room
+    settings = {**config["trial"], "grasp": tested["grasp"]}
+    _, tested_room = fresh_trial_parts({**config, "trial": settings, "world": tested["world"]})
+    return trial.evaluation_elsewhere(world), tested_room
 
 
 def measured(
@@ -145,13 +123,13 @@ def measured(
     evaluated_at: int,
     progress: bool = False,
 ) -> tuple[dict, dict[str, bytes]]:
-    """(eval.json's numbers, the tables' bytes by file name) of an actor tested in `room` as
-    a trial's final agent is: the project's measure (`competence_of`, `actor`), the vocal
-    table of `best_word_distance` (the best distance of the learner's own sounds to each word,
-    in the order of the voice's words) and the study's tests (`study_tests_of`, `study_actor`),
-    which start from the room's scene as it is now. `config`: the trial's (or a config of its
-    form: its "trial" section's grasp, seed, babbling and iterations are summarised).
-    The same for every learner: only the actors differ."""
+    """(eval.json's numbers, the tables' bytes by kind: evaluation.TABLES) of an actor tested in
+    `room` as a trial's final agent is: the project's measure (`competence_of`, `actor`), the vocal
+    table of `best_word_distance` (the best distance of the learner's own sounds to each word, in
+    the order of the voice's words) and the study's tests (`study_tests_of`, `study_actor`), which
+    start from the room's scene as it is now. `config`: the trial's (or a config of its form: its
+    "trial" section's grasp, seed, babbling and iterations are summarised). The same for every
+    learner: only the actors differ."""
     # The study's measure starts from it too: the scene learning left, or in another world,
     # that world's start scene.
     final_state = room.get_state()
@@ -169,21 +147,8 @@ def measured(
     room.set_state(final_state)
     study = study_tests_of(study_actor, room, StudyMeasureSettings(settings.n_placements))
     tables = {
-        COMPETENCE_FILE: storage.table_bytes(competence),
-        VOCAL_FILE: storage.table_bytes(vocal),
-        STUDY_TESTS_FILE: storage.table_bytes(study),
+        "competence": storage.table_bytes(competence),
+        "vocal": storage.table_bytes(vocal),
+        "study_tests": storage.table_bytes(study),
     }
     return summary, tables
-
-
-def evaluation_files(summary: dict, tables: dict[str, bytes], config: dict) -> dict[str, bytes]:
-    """The files of an evaluation of the trial whose config.json is `config`, eval.json last:
-    it vouches for the tables (storage.write_files). eval.json lists the tables with their
-    sizes and checksums, so that a reader refuses a table lost, damaged or left from another
-    evaluation, and records its own checksum and the trial's identity, so that a reader
-    refuses it damaged or another trial's (experiments/trial_dir/eval_record.py). A word's best
-    distance (and so a median) is infinite until the learner's first voice movement: eval.json,
-    standard JSON, holds null for it (experiments/analysis/results.py reads it back as infinity);
-    `summary` itself keeps the numbers."""
-    summary[manifest.EVAL_FILES_KEY] = manifest.evaluation_files(tables)
-    return {**tables, EVAL_FILE: eval_record.evaluation_json(summary, config)}

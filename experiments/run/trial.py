@@ -27,29 +27,12 @@ from experiments.run import estimate, progress_bar, stop_requests
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import typed_config
 from experiments.run.trial_parts import learner_values, log_row, trial_parts
-from experiments.trial_dir import (
-    backend_record,
-    manifest,
-    memory_segments,
-    provenance_file,
-    storage,
-)
-from experiments.trial_dir.layout import (
-    BACKEND_FILE,
-    CHECKPOINT_FILE,
-    CHUNK_IDENTITY_KEY,
-    MEMORY_DIR,
-    PREVIOUS_CHECKPOINT_FILE,
-    chunk_path,
-)
-from experiments.trial_dir.log_schema import (
-    LEARNER_COLUMNS,
-    LEARNER_DTYPE,
-    SOURCE_COLUMNS,
-    WORDS_LOG_PERIOD,
-)
-from experiments.trial_dir.opening import OpenedTrial, open_trial_directory
+from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, WORDS_LOG_PERIOD
+from experiments.trial_dir.opening import OpenedTrial
+from experiments.trial_dir.writing import open_for_writing
+from learner.agent import Agent
 from models.layout import TOYS, block_slice
+from sim import Playroom
 
 _SOUND = block_slice("sound")
 _TOY_MOVED_BY = tuple(f"{toy}_moved_by" for toy in TOYS)
@@ -78,49 +61,37 @@ class Trial:
         parts = build()
         words = len(parts[1].vocal_tract.config.words)
         fits = functools.partial(estimate.check_fits, settings=settings, resume=resume)
-        opened = open_trial_directory(out_dir, self.config, parts, build, resume, words, fits)
-        self._lock = opened.lock  # held from here: `close` gives it up
+        # Held from here: `close` gives it up.
+        self.writer = open_for_writing(out_dir, self.config, parts, build, resume, words, fits)
         try:
-            self._take(opened)
+            self._take(self.writer.opened)
             if not self.finished:  # who computes from here on (provenance.json)
-                self.notices += provenance_file.record_start(
-                    self.dir, self.iteration, self.room.vocal_tract.data_record()
+                self.notices += self.writer.record_start(
+                    self.iteration, self.room.vocal_tract.data_record()
                 )
             self._record_backend()
         except BaseException:
             self.close()
             raise
 
-    def _take(self, opened: OpenedTrial) -> None:
+    def _take(self, opened: OpenedTrial[Agent, Playroom]) -> None:
         """Where the run starts: what the opening returned."""
         self.dir, self.notices = opened.dir, opened.notices
-        self.identity, self.source = opened.identity, opened.source
         self.agent, self.room = opened.agent, opened.room
         self.iteration = opened.iteration
         self.best_word_distance, self.counts = opened.best_word_distance, opened.counts
-        self.memory = opened.memory  # what the memory's segments hold: each checkpoint the rest
-        self.manifest_pointer, self.recorded = opened.manifest_pointer, opened.recorded
-        self.unrecorded = opened.unrecorded
         self.elapsed: float | None = None  # seconds of the last `run_trial`
         self.start_iteration = self.iteration
 
     def close(self) -> None:
         """Give up the directory's lock."""
-        self._lock.release()
+        self.writer.close()
 
     def _record_backend(self) -> None:
-        """What the trial's backend declares, for analysis to read (backend.json): written once,
-        or rewritten when lost or damaged if the backend declares what the trial recorded."""
+        """What the trial's backend declares, for analysis to read (backend.json)."""
         backend = self.room.backend
-        if self.finished and not (self.dir / BACKEND_FILE).exists() and self.recorded is None:
-            return  # a finished trial from before backend.json: read from its config instead
-        notice = backend_record.write_once(
-            self.dir,
-            backend.name,
-            backend.reach(),
-            backend.capabilities(),
-            self.recorded,
-            self.unrecorded,
+        notice = self.writer.record_backend(
+            backend.name, backend.reach(), backend.capabilities(), self.finished
         )
         if notice is not None:
             self.notices.append(notice)
@@ -131,45 +102,14 @@ class Trial:
 
     # Checkpoints --------------------------------------------------------------------------
     def _save_checkpoint(self) -> None:
-        # The rows the memory stored since the last checkpoint, in a segment of their own, on
-        # disk before the checkpoint that names it; the checkpoint holds the rest.
-        memory = memory_segments.write_segment(
-            self.dir, self.agent, self.memory, self.iteration, self.identity
+        self.writer.save_checkpoint(
+            self.agent,
+            self.room,
+            self.iteration,
+            self.finished,
+            self.counts,
+            self.best_word_distance,
         )
-        if memory.newest != self.memory.newest:
-            self.unrecorded.append(self.dir / MEMORY_DIR / str(memory.newest))
-        # Every file written since the last checkpoint, recorded before the checkpoint that
-        # names the record (experiments/trial_dir/manifest.py).
-        pointer = manifest.write_period(
-            self.dir, self.iteration, self.manifest_pointer, self.unrecorded, self.identity
-        )
-        room_state = self.room.get_state()
-        # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
-        state = self.agent.state_dict(rows_from=memory.rows)
-        arrays = {f"{memory_segments.AGENT}{k}": v for k, v in state.items()}
-        arrays["room/physics"] = room_state.pop("physics")
-        arrays["best_word_distance"] = self.best_word_distance
-        meta = {
-            "iteration": self.iteration,
-            "finished": self.finished,
-            "room": room_state,
-            "counts": self.counts,
-            # Whose checkpoint it is: one copied into another trial is refused there.
-            "identity": self.identity,
-            # The name the trial was created as, which its log rows carry wherever it lies.
-            "trial_name": self.source["trial"],
-            memory_segments.MEMORY_KEY: memory.meta(),
-            manifest.MANIFEST_KEY: pointer,
-        }
-        newest = self.dir / CHECKPOINT_FILE
-        if newest.exists():
-            # Kept as the previous one by a second name, not moved: at every moment the trial
-            # has a whole checkpoint.npz (moved, there was none while the new one was written,
-            # and a writer killed then left only the previous one).
-            storage.keep_copy(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
-        storage.write_arrays(newest, arrays, meta)
-        self.memory = memory
-        self.manifest_pointer, self.unrecorded = pointer, []
 
     # The loop -----------------------------------------------------------------------------
     def run(
@@ -194,7 +134,7 @@ class Trial:
         self, total: int, bar: tqdm, report: Callable[[int], None] | None, every: int
     ) -> None:
         """Iterate until `total`, writing logs and a checkpoint every `checkpoint_every`."""
-        if self.iteration == 0 and not (self.dir / CHECKPOINT_FILE).exists():
+        if self.iteration == 0 and not self.writer.has_checkpoint():
             # A checkpoint before the first log chunk: a directory with logs then always has
             # a checkpoint, unless it was lost, and a resume can tell which
             # (experiments/trial_dir/resume.py, `prepare_resume`).
@@ -249,23 +189,9 @@ class Trial:
         values = np.vstack([v for _, v in rows]).astype(LEARNER_DTYPE)
         learner = pd.DataFrame(values, columns=list(LEARNER_COLUMNS))
         iterations = pd.concat([events, learner], axis=1)
-        self._write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
+        self.writer.write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
         if word_rows:
-            self._write_chunk("words", start, pd.DataFrame(word_rows))
-
-    def _write_chunk(
-        self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
-    ) -> None:
-        """One chunk of a log, in its kind's folder, its source columns first, carrying the
-        trial's identity."""
-        for position, column in enumerate(SOURCE_COLUMNS):
-            table.insert(position, column, self.source[column])
-        path = chunk_path(self.dir, kind, start)
-        path.parent.mkdir(exist_ok=True)
-        # Written into the Parquet schema's metadata (experiments/trial_dir/layout.py).
-        table.attrs[CHUNK_IDENTITY_KEY] = self.identity
-        storage.write_table(path, table, plain=plain)
-        self.unrecorded.append(path)
+            self.writer.write_chunk("words", start, pd.DataFrame(word_rows))
 
 
 def run_trial(

@@ -7,16 +7,11 @@ experiments/trial_dir/log_schema.py declares.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import numpy as np
 
-from experiments.trial_dir import manifest, storage
-from experiments.trial_dir.checkpoint import restore_newest
-from experiments.trial_dir.checks import check_files
-from experiments.trial_dir.config_file import UnknownSettingError, check_known, with_added_settings
-from experiments.trial_dir.errors import TrialConfigError, TrialError
-from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE, PREVIOUS_CHECKPOINT_FILE
+from experiments.trial_dir.errors import TrialConfigError
+from experiments.trial_dir.layout import CONFIG_FILE
 from experiments.trial_dir.log_schema import (
     CAREGIVER_SAID,
     DIVERGED,
@@ -31,6 +26,7 @@ from experiments.trial_dir.log_schema import (
     WORD_RECOGNISED,
     moved_by,
 )
+from experiments.trial_dir.reading import open_for_reading
 from learner.agent import Agent, Proposal
 from learner.config import LearnerConfig
 from models.layout import BLOCK_DIM, context_indices
@@ -116,31 +112,8 @@ def trial_parts(
 
 
 def load_trial(trial_dir: str | os.PathLike) -> tuple[dict, Agent, Playroom, dict]:
-    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta).
-    TrialError unless its newest checkpoint is its own and readable, and its logs up to it,
-    its memory segments and backend.json whole and as its manifest recorded them: what is
-    derived from it (an evaluation, a report) would not be the trial's."""
-    trial_dir = Path(trial_dir)
-    if not (trial_dir / CONFIG_FILE).exists():
-        raise TrialError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    if not any((trial_dir / n).exists() for n in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE)):
-        raise TrialError(f"{trial_dir} has no checkpoint yet")
-    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
-    try:
-        check_known(config, trial_dir / CONFIG_FILE)
-    except UnknownSettingError as exc:
-        raise TrialError(str(exc)) from None
-    agent, room, meta, fallback = restore_newest(
-        trial_dir, config, None, lambda: fresh_trial_parts(config)
-    )
-    if fallback is not None:
-        # Only the resume may fall back: it rewrites the logs past the previous checkpoint.
-        raise TrialError(
-            f"{fallback}; `playroom run --out {trial_dir} --resume` continues the trial from "
-            f"{PREVIOUS_CHECKPOINT_FILE} (iteration {meta['iteration']}), then evaluate it"
-        )
-    if meta["iteration"] == 0:
-        raise TrialError(f"{trial_dir} has not reached its first checkpoint yet")
-    if check_files(trial_dir, meta, config) is None:
-        manifest.warn_unchecked(trial_dir)
-    return config, agent, room, meta
+    """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta), its
+    agent and room built from its config.json and restored from its newest checkpoint, the
+    trial checked whole first (experiments/trial_dir/reading.py `TrialReading.restored`:
+    TrialError otherwise)."""
+    return open_for_reading(trial_dir).restored(fresh_trial_parts)

@@ -1,7 +1,8 @@
-"""A trial's opening reads from top to bottom (experiments/run/trial.py,
-experiments/trial_dir/opening.py): the
-trial calls each of its stages once, in order, and no module of experiments is called back by
-one it called, for a new trial and for a resume. Followed with a profiler over the calls
+"""A trial's opening reads from top to bottom (experiments/run/trial.py, through the trial
+directory's writing face, experiments/trial_dir/writing.py, to its opening): the trial types its
+settings, builds its parts, then only asks the writing face, which calls each stage once, in
+order, and no module of experiments is called back by one it called, for a new trial and for a
+resume. Followed with a profiler over the calls
 between modules, from the trial's creation to its first iteration."""
 
 from __future__ import annotations
@@ -17,14 +18,11 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial import Trial, run_trial
 
 ROOT = Path(experiments.__file__).resolve().parent
-# The trial's stages, in the order it calls them.
-STAGES = [
-    "run.trial_config",
-    "run.trial_parts",
-    "trial_dir.opening",
-    "trial_dir.provenance_file",
-    "trial_dir.backend_record",
-]
+# What the trial calls, in order: its settings typed, its parts built, then the directory's
+# writing face only (the opening, who computes, what the backend declares).
+CALLED = ["run.trial_config", "run.trial_parts", "trial_dir.writing"]
+# The writing face's stages, in the order it calls them.
+STAGES = ["trial_dir.opening", "trial_dir.provenance_file", "trial_dir.backend_record"]
 
 # What every step of the opening reads and writes through: the trial directory's files.
 FILE_LAYERS = {f"trial_dir.{m}" for m in ("storage", "layout", "config_file", "manifest")}
@@ -94,7 +92,8 @@ def test_a_trial_opens_top_to_bottom(tmp_path, resume):
         run_trial(out, settings, progress=False)
         settings = TrialSettings(iterations=40, seed=1, checkpoint_every=10)
     entered, edges = _calls(lambda: Trial(out, settings, resume=resume))
-    assert entered["run.trial"] == STAGES
+    assert list(dict.fromkeys(entered["run.trial"])) == CALLED
+    assert entered["trial_dir.writing"] == STAGES
     assert _cycle(edges) is None
     # The opening enters each of its own steps once (the disk estimate, the lock, the checks
     # of what lies in the directory: a resume's, or a new trial's litter), whatever file layers

@@ -1,0 +1,215 @@
+"""A trial directory opened for reading: `open_for_reading(path)`, one of the package's two
+faces (the other is writing.py). Every reader of a trial (analysis, reports, measures, videos,
+the baseline, a batch's checks, the Python API) reads it through the `TrialReading` this
+returns, part by part, each part checked as it is read and read once:
+
+- `config()`: config.json, with the settings added since it was written (config_file.py);
+- `log(kind, columns)`: one of its logs, every chunk checked against the trial's manifest and
+  by the identity it carries (log_reading.py);
+- `evaluation()`, `evaluation_in(world)`: its evaluations, eval.json and the tables it lists
+  checked (evaluation.py);
+- `checkpoint_meta()`, `checkpoint_arrays()`, `restored(parts_of)`: its newest checkpoint, its
+  metadata, its arrays with the memory segments it names, or restored into an agent and room
+  the caller builds, the trial checked whole first (checkpoint.py, checks.py);
+- `backend()`, `computed_on()`, `timing()`: backend.json, provenance.json, timing.json.
+
+Opening reads nothing: a part is read when asked for, so that a reader pays only for what it
+reads (a report reads no checkpoint, an evaluation no evaluation). No simulator is loaded.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from experiments.trial_dir import backend_record, checkpoint, manifest, storage
+from experiments.trial_dir.checks import check_files
+from experiments.trial_dir.config_file import UnknownSettingError, check_known, with_added_settings
+from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.eval_worlds import OWN, own_world
+from experiments.trial_dir.evaluation import Evaluation, in_world
+from experiments.trial_dir.layout import (
+    BACKEND_FILE,
+    CHECKPOINT_FILE,
+    CONFIG_FILE,
+    PREVIOUS_CHECKPOINT_FILE,
+    TIMING_FILE,
+    is_trial_dir,
+)
+from experiments.trial_dir.log_reading import read_log_checked
+from experiments.trial_dir.provenance_file import computed_on
+
+# What marks a folder as a trial directory, as messages say it.
+TRIAL_MARKS = "its config.json and log/"
+
+
+@dataclass
+class TrialReading:
+    """A trial directory opened for reading (the module's docstring): its parts, each read
+    when first asked for."""
+
+    dir: Path
+    _config: dict | None = field(default=None, repr=False)
+
+    # config.json ---------------------------------------------------------------------------
+    @property
+    def config_path(self) -> Path:
+        """config.json, as messages name it."""
+        return self.dir / CONFIG_FILE
+
+    def is_trial(self) -> bool:
+        """Whether the folder is a trial directory (`playroom run` wrote its config.json and
+        log/); another tool's folder with a config.json is not one."""
+        return is_trial_dir(self.dir)
+
+    def config_json(self) -> Any:
+        """config.json as it lies (storage.CorruptFileError if it is not JSON; OSError if it
+        cannot be read)."""
+        return storage.read_json(self.config_path)
+
+    def config(self) -> dict:
+        """config.json with every setting added since it was written set to the value older
+        trials ran with (config_file.with_added_settings); read once."""
+        if self._config is None:
+            self._config = with_added_settings(self.config_json())
+        return self._config
+
+    def checked_config(self) -> dict:
+        """`config()`, config_file.UnknownSettingError naming a setting no version wrote."""
+        config = self.config()
+        check_known(config, self.config_path)
+        return config
+
+    # Logs ----------------------------------------------------------------------------------
+    def log(
+        self, kind: str = "iterations", columns: Sequence[str] | None = None
+    ) -> tuple[pd.DataFrame, bool]:
+        """(one log, every chunk checked: log_reading.read_log_checked; whether the manifest
+        checked it, False for a trial from before manifests, which the caller says)."""
+        return read_log_checked(self.dir, kind, columns)
+
+    # The checkpoint ------------------------------------------------------------------------
+    def has_checkpoint(self) -> bool:
+        """Whether it holds a checkpoint, the newest or the previous one."""
+        return checkpoint.has_checkpoint(self.dir)
+
+    def has_newest_checkpoint(self) -> bool:
+        return (self.dir / CHECKPOINT_FILE).exists()
+
+    def checkpoint_meta(self) -> dict:
+        """The newest checkpoint's metadata, its arrays not read (storage.CorruptFileError if it
+        is missing or cannot be read)."""
+        return storage.read_meta(self.dir / CHECKPOINT_FILE)
+
+    def checkpoint_arrays(self) -> tuple[dict[str, np.ndarray], dict]:
+        """The newest checkpoint's arrays, with every model's memory rows its segments hold,
+        and its metadata (checkpoint.newest_arrays)."""
+        return checkpoint.newest_arrays(self.dir)
+
+    def check_checkpoint_identity(self, meta: dict, config: dict) -> None:
+        """TrialError if the newest checkpoint (of metadata `meta`) is another trial's."""
+        checkpoint.check_identity(self.dir / CHECKPOINT_FILE, meta, config)
+
+    def check_files(self, meta: dict, config: dict) -> manifest.Manifest | None:
+        """TrialError unless the logs and backend.json a checkpoint of metadata `meta` covers
+        are whole and as recorded (checks.check_files); the manifest, None before manifests."""
+        return check_files(self.dir, meta, config)
+
+    def restored(
+        self, parts_of: Callable[[dict], tuple[checkpoint.A, checkpoint.R]]
+    ) -> tuple[dict, checkpoint.A, checkpoint.R, dict]:
+        """A finished or checkpointed trial, read-only: (config, agent, room, checkpoint meta),
+        the agent and room `parts_of(config)` builds, restored from the newest checkpoint.
+        TrialError unless its newest checkpoint is its own and readable, and its logs up to it,
+        its memory segments and backend.json whole and as its manifest recorded them: what is
+        derived from it (an evaluation, a report) would not be the trial's."""
+        if not self.config_path.exists():
+            raise TrialError(f"{self.dir} holds no trial ({CONFIG_FILE} is missing)")
+        if not self.has_checkpoint():
+            raise TrialError(f"{self.dir} has no checkpoint yet")
+        try:
+            config = self.checked_config()
+        except UnknownSettingError as exc:
+            raise TrialError(str(exc)) from None
+        agent, room, meta, fallback = checkpoint.restore_newest(
+            self.dir, config, None, lambda: parts_of(config)
+        )
+        if fallback is not None:
+            # Only the resume may fall back: it rewrites the logs past the previous checkpoint.
+            raise TrialError(
+                f"{fallback}; `playroom run --out {self.dir} --resume` continues the trial from "
+                f"{PREVIOUS_CHECKPOINT_FILE} (iteration {meta['iteration']}), then evaluate it"
+            )
+        if meta["iteration"] == 0:
+            raise TrialError(f"{self.dir} has not reached its first checkpoint yet")
+        if check_files(self.dir, meta, config) is None:
+            manifest.warn_unchecked(self.dir)
+        return config, agent, room, meta
+
+    def progress(self) -> tuple[int, int]:
+        """(iteration of the newest readable checkpoint, bytes it holds on disk): checkpoint.py."""
+        return checkpoint.progress(self.dir)
+
+    # Evaluations ---------------------------------------------------------------------------
+    def evaluation(self, folder: str | os.PathLike | None = None) -> Evaluation:
+        """Its evaluation in `folder` (by default its own, in the trial directory)."""
+        return Evaluation(self.dir, self.dir if folder is None else Path(folder))
+
+    def evaluation_in(self, world: str) -> Evaluation:
+        """Its evaluation in eval world `world`: its own (eval.json in the trial directory)
+        where `world` is OWN or the trial's own world (eval_worlds.own_world, from
+        `config()`), else its eval-in-WORLD/. EvalWorldError for an unknown world or a
+        config.json that names no preset."""
+        if world == OWN or own_world(self.config(), world):
+            return self.evaluation()
+        return in_world(self.dir, world)
+
+    def evaluation_elsewhere(self, world: str) -> Evaluation:
+        """Its evaluation in eval-in-WORLD/, whether or not `world` is its own."""
+        return in_world(self.dir, world)
+
+    # The records it keeps of itself ---------------------------------------------------------
+    def backend(self, config: dict) -> dict:
+        """What its backend declared (backend.json, checked against the manifest; older trials:
+        computed from `config`, its config.json): backend_record.read_record."""
+        return backend_record.read_record(self.dir, config)
+
+    def has_backend_record(self) -> bool:
+        return (self.dir / BACKEND_FILE).exists()
+
+    def computed_on(self) -> list[dict[str, Any]]:
+        """Who computed it, stretch by stretch (provenance_file.computed_on)."""
+        return computed_on(self.dir)
+
+    @property
+    def timing_path(self) -> Path:
+        """timing.json, as messages name it."""
+        return self.dir / TIMING_FILE
+
+    def timing(self) -> Any | None:
+        """timing.json as it lies (the seconds and iterations of the batch task that last ran
+        the trial); None when the trial did not record it. storage.CorruptFileError if it is
+        not JSON."""
+        path = self.timing_path
+        return storage.read_json(path) if path.exists() else None
+
+
+def open_for_reading(trial_dir: str | os.PathLike) -> TrialReading:
+    """A trial directory opened for reading (the module's docstring). Nothing is read yet."""
+    return TrialReading(Path(trial_dir))
+
+
+def trials_in(folder: str | os.PathLike) -> list[Path]:
+    """The trial directories a folder (a batch directory) holds, by name."""
+    return sorted(d for d in Path(folder).iterdir() if d.is_dir() and is_trial_dir(d))
+
+
+def is_trial(folder: str | os.PathLike) -> bool:
+    """Whether a folder is a trial directory (`TrialReading.is_trial`)."""
+    return is_trial_dir(folder)

@@ -1,0 +1,230 @@
+"""A trial directory opened for writing, the package's second face (the first is reading.py):
+what a writer does to a trial directory, decided and recorded here, so that it names no file.
+
+- `open_for_writing(...)`: a trial's run, started or resumed: the opening's decision
+  (opening.py: the directory checked, locked, config.json written or compared, a resume's
+  checkpoint restored, an extension), then its recorded writes (`TrialWriter`): log chunks,
+  memory segments, each checkpoint with the manifest of what was written since the one before
+  it, backend.json and provenance.json.
+- `open_for_evaluation(trial_dir)`: the trial's derived files, under its lock
+  (`EvaluationWriter`): the trial restored and checked whole, a killed writer's litter removed,
+  its evaluation in a world written as one unit, eval.json last.
+
+Order on disk, for crash safety: a period's chunks and memory segment, then its manifest file,
+then the checkpoint that names it (manifest.py, memory_segments.py). No simulator is loaded:
+the agent and room are the caller's, of which only what is written is asked for.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Generic, Protocol
+
+import numpy as np
+import pandas as pd
+
+from experiments.trial_dir import backend_record, manifest, memory_segments, storage
+from experiments.trial_dir.checkpoint import A, Build, R
+from experiments.trial_dir.checks import remove_litter
+from experiments.trial_dir.errors import TrialError, TrialLocked
+from experiments.trial_dir.evaluation import Evaluation, evaluation_files
+from experiments.trial_dir.layout import (
+    BACKEND_FILE,
+    CHECKPOINT_FILE,
+    CHUNK_IDENTITY_KEY,
+    CONFIG_FILE,
+    MEMORY_DIR,
+    PREVIOUS_CHECKPOINT_FILE,
+    chunk_path,
+)
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.log_schema import SOURCE_COLUMNS
+from experiments.trial_dir.opening import OpenedTrial, open_trial_directory
+from experiments.trial_dir.provenance_file import record_start
+from experiments.trial_dir.reading import TrialReading
+
+
+class Checkpointed(memory_segments.Memories, Protocol):
+    """What a checkpoint holds of an agent (learner.agent.Agent): its state, each model's rows
+    past those its memory segments hold."""
+
+    def state_dict(self, rows_from: dict[int, int] | None = None) -> dict[str, np.ndarray]: ...
+
+
+class RoomState(Protocol):
+    """What a checkpoint holds of a room (sim.Playroom): its state, its physics' as arrays."""
+
+    def get_state(self) -> dict: ...
+
+
+class TrialWriter(Generic[A, R]):
+    """A trial directory opened for its run (`open_for_writing`), locked until `close`: what the
+    run starts from (`opened`), and the writes it records."""
+
+    def __init__(self, opened: OpenedTrial[A, R]) -> None:
+        self.opened = opened
+        self.dir = opened.dir
+        # What the memory's segments hold (each checkpoint holds the rest), the newest manifest
+        # file, the manifest of the checkpoint restored, the data files written since it.
+        self._memory = opened.memory
+        self._pointer = opened.manifest_pointer
+        self._recorded = opened.recorded
+        self._unrecorded = opened.unrecorded
+
+    def close(self) -> None:
+        """Give up the directory's lock."""
+        self.opened.lock.release()
+
+    def has_checkpoint(self) -> bool:
+        return (self.dir / CHECKPOINT_FILE).exists()
+
+    def record_start(self, iteration: int, inputs: dict[str, str] | None) -> list[str]:
+        """Who computes from `iteration` on, appended to provenance.json
+        (provenance_file.record_start); the lines to tell the user."""
+        return record_start(self.dir, iteration, inputs)
+
+    def record_backend(
+        self, grasp: str, reach: float, capabilities: dict[str, bool], finished: bool
+    ) -> str | None:
+        """What the trial's backend declares, for analysis to read (backend.json): written
+        once, or rewritten when lost or damaged if the backend declares what the trial recorded
+        (backend_record.write_once); a line to tell the user, or None. A finished trial from
+        before backend.json is left without one: readers compute it from its config."""
+        if finished and not (self.dir / BACKEND_FILE).exists() and self._recorded is None:
+            return None
+        return backend_record.write_once(
+            self.dir, grasp, reach, capabilities, self._recorded, self._unrecorded
+        )
+
+    def write_chunk(
+        self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
+    ) -> None:
+        """One chunk of a log, in its kind's folder, its source columns first, carrying the
+        trial's identity; recorded by the next checkpoint's manifest."""
+        for position, column in enumerate(SOURCE_COLUMNS):
+            table.insert(position, column, self.opened.source[column])
+        path = chunk_path(self.dir, kind, start)
+        path.parent.mkdir(exist_ok=True)
+        # Written into the Parquet schema's metadata (layout.py).
+        table.attrs[CHUNK_IDENTITY_KEY] = self.opened.identity
+        storage.write_table(path, table, plain=plain)
+        self._unrecorded.append(path)
+
+    def save_checkpoint(
+        self,
+        agent: Checkpointed,
+        room: RoomState,
+        iteration: int,
+        finished: bool,
+        counts: dict[str, int],
+        best_word_distance: np.ndarray,
+    ) -> None:
+        """The checkpoint at `iteration`: the rows the memory stored since the last one in a
+        segment of their own, then the manifest of every file written since it, then the
+        checkpoint (the agent's state past its segments, the room's, where the run stands),
+        the one before it kept as the previous."""
+        memory = memory_segments.write_segment(
+            self.dir, agent, self._memory, iteration, self.opened.identity
+        )
+        if memory.newest != self._memory.newest:
+            self._unrecorded.append(self.dir / MEMORY_DIR / str(memory.newest))
+        pointer = manifest.write_period(
+            self.dir, iteration, self._pointer, self._unrecorded, self.opened.identity
+        )
+        room_state = room.get_state()
+        # The agent's state is plain arrays (its config and generator as 0-d JSON strings).
+        state = agent.state_dict(rows_from=memory.rows)
+        arrays = {f"{memory_segments.AGENT}{k}": v for k, v in state.items()}
+        arrays["room/physics"] = room_state.pop("physics")
+        arrays["best_word_distance"] = best_word_distance
+        meta = {
+            "iteration": iteration,
+            "finished": finished,
+            "room": room_state,
+            "counts": counts,
+            # Whose checkpoint it is: one copied into another trial is refused there.
+            "identity": self.opened.identity,
+            # The name the trial was created as, which its log rows carry wherever it lies.
+            "trial_name": self.opened.source["trial"],
+            memory_segments.MEMORY_KEY: memory.meta(),
+            manifest.MANIFEST_KEY: pointer,
+        }
+        newest = self.dir / CHECKPOINT_FILE
+        if newest.exists():
+            # Kept as the previous one by a second name, not moved: at every moment the trial
+            # has a whole checkpoint.npz (moved, there was none while the new one was written,
+            # and a writer killed then left only the previous one).
+            storage.keep_copy(newest, self.dir / PREVIOUS_CHECKPOINT_FILE)
+        storage.write_arrays(newest, arrays, meta)
+        self._memory = memory
+        self._pointer, self._unrecorded = pointer, []
+
+
+def open_for_writing(
+    out_dir: str | os.PathLike,
+    config: dict,
+    parts: tuple[A, R],
+    build: Build[A, R],
+    resume: bool,
+    words: int,
+    fits: Callable[[Path], str | None],
+) -> TrialWriter[A, R]:
+    """A trial directory opened for the run of the trial of `config`
+    (opening.open_trial_directory decides, and says what each argument is), locked until the
+    writer is closed. TrialError (one line) if it cannot be used."""
+    return TrialWriter(open_trial_directory(out_dir, config, parts, build, resume, words, fits))
+
+
+@dataclass
+class EvaluationWriter:
+    """A trial directory opened for its derived files (`open_for_evaluation`), locked until
+    `close`; `trial` reads it."""
+
+    trial: TrialReading
+    lock: DirectoryLock
+
+    def close(self) -> None:
+        self.lock.release()
+
+    def remove_litter(self) -> list[str]:
+        """The temporary files of killed writers removed (under the lock: their writers are
+        dead); their paths in the directory."""
+        return remove_litter(self.trial.dir)
+
+    def check_writable(self, evaluation: Evaluation) -> None:
+        """TrialError, before minutes of tests whose results could not be kept, unless the
+        folder of `evaluation` can be written."""
+        try:
+            storage.check_writable(evaluation.folder)
+        except OSError as exc:
+            raise TrialError(
+                f"cannot write into {evaluation.folder}: {storage.reason(exc)}"
+            ) from None
+
+    def write(
+        self, evaluation: Evaluation, summary: dict, tables: dict[str, bytes], config: dict
+    ) -> None:
+        """`evaluation`'s files written as one unit, eval.json last (evaluation_files:
+        `tables` by kind, `summary` its numbers, `config` the trial's config.json): a write that
+        fails (disk full) leaves the evaluation's files as they were."""
+        storage.write_files(evaluation.folder, evaluation_files(summary, tables, config))
+
+
+def open_for_evaluation(trial_dir: str | os.PathLike) -> EvaluationWriter:
+    """A trial directory opened for its derived files, its lock taken before the trial is read:
+    a live writer's files are caught mid-change (its checkpoint between two renames), and it is
+    the writer that must be named (TrialLocked). TrialError for a folder that holds no trial,
+    or whose lock cannot be made or opened for writing (read-only)."""
+    trial = TrialReading(Path(trial_dir))
+    if not trial.config_path.is_file():  # the lock would make the folder
+        raise TrialError(f"{trial.dir} holds no trial ({CONFIG_FILE} is missing)")
+    try:
+        lock = DirectoryLock(trial.dir).acquire()
+    except DirectoryLocked as exc:
+        raise TrialLocked(str(exc)) from None
+    except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
+        raise TrialError(f"cannot write into {trial.dir}: {storage.reason(exc)}") from None
+    return EvaluationWriter(trial, lock)
