@@ -23,14 +23,9 @@ from experiments.analysis.results import (
     _evaluation_table,
     _read_json,
 )
-from experiments.trial_dir import eval_record, storage
-from experiments.trial_dir.layout import (
-    BASELINE_FILE,
-    COMPETENCE_FILE,
-    EVAL_FILE,
-    STUDY_TESTS_FILE,
-    VOCAL_FILE,
-)
+from experiments.trial_dir import storage
+from experiments.trial_dir.baseline_run import BASELINE_RUN_MARK, open_baseline_run
+from experiments.trial_dir.evaluation import TABLES
 from experiments.trial_dir.provenance import SHORT_FIELDS, short_record
 
 
@@ -63,10 +58,6 @@ class BaselineResults:
         )
 
 
-def is_baseline_dir(directory: Path) -> bool:
-    return (directory / BASELINE_FILE).is_file()
-
-
 def _summary(run_dir: Path, config: dict) -> dict:
     """A run's eval.json, checked against itself and the trial config its baseline.json
     records (experiments/trial_dir/eval_record.py); ReportError (one line) otherwise."""
@@ -75,7 +66,7 @@ def _summary(run_dir: Path, config: dict) -> dict:
         "(its trained policies are kept)"
     )
     try:
-        return eval_record.read_evaluation(run_dir, config, remedy)
+        return open_baseline_run(run_dir).evaluation().summary(config, remedy)
     except storage.CorruptFileError as exc:
         raise ReportError(" ".join(str(exc).split())) from None
 
@@ -87,26 +78,28 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
     root = Path(runs_dir)
     if not root.is_dir():
         raise ReportError(f"{root} is not a directory")
-    dirs = sorted(d for d in root.iterdir() if d.is_dir() and is_baseline_dir(d))
-    if not dirs:
-        raise ReportError(f"no baseline runs found in {root} (folders holding {BASELINE_FILE})")
-    unfinished = [d.name for d in dirs if not (d / EVAL_FILE).is_file()]
+    runs = [open_baseline_run(d) for d in sorted(root.iterdir()) if d.is_dir()]
+    runs = [run for run in runs if run.is_run()]
+    if not runs:
+        raise ReportError(f"no baseline runs found in {root} (folders holding {BASELINE_RUN_MARK})")
+    dirs = [run.dir for run in runs]
+    unfinished = [run.dir.name for run in runs if not run.evaluation().path.is_file()]
     if unfinished:
+        name = runs[0].evaluation().path.name
         raise ReportError(
-            f"{len(unfinished)} of {len(dirs)} runs in {root} are not finished (no {EVAL_FILE}): "
+            f"{len(unfinished)} of {len(dirs)} runs in {root} are not finished (no {name}): "
             f"{', '.join(unfinished[:5])}; run the same `playroom rl-baseline` command again"
         )
     trials: list[dict] = []
-    tables: dict[str, list[pd.DataFrame]] = {
-        name: [] for name in (COMPETENCE_FILE, VOCAL_FILE, STUDY_TESTS_FILE)
-    }
+    tables: dict[str, list[pd.DataFrame]] = {kind: [] for kind in TABLES}
     configs: dict[str, dict] = {}
     where = []
-    for d in dirs:
-        recorded = _read_json(d / BASELINE_FILE)
+    for run in runs:
+        d = run.dir
+        recorded = _read_json(run.record_path)
         config = recorded.get("trial") if isinstance(recorded, dict) else None
         if not isinstance(config, dict) or not isinstance(config.get("trial"), dict):
-            raise ReportError(f"{d / BASELINE_FILE} lacks the trial's config: run it again")
+            raise ReportError(f"{run.record_path} lacks the trial's config: run it again")
         summary = _summary(d, config)
         keys = {"trial": d.name, "group": summary["grasp"], "seed": summary["seed"]}
         if configs.setdefault(summary["grasp"], shared_config(config)) != shared_config(config):
@@ -125,17 +118,17 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
                 "babbling": summary.get("babbling"),
                 "iterations": summary.get("iterations"),
                 "n_placements": summary.get("n_placements"),
-                **_eval_numbers(d, summary),
+                **_eval_numbers(run.evaluation().path, summary),
             }
         )
-        for name, rows in tables.items():
-            rows.append(_evaluation_table(d / name, summary).assign(**keys))
+        for kind, rows in tables.items():
+            rows.append(_evaluation_table(run.evaluation(), kind, summary).assign(**keys))
     return BaselineResults(
         runs_dir=root,
         trials=pd.DataFrame(trials),
-        competence=pd.concat(tables[COMPETENCE_FILE], ignore_index=True),
-        vocal=pd.concat(tables[VOCAL_FILE], ignore_index=True),
-        study_tests=pd.concat(tables[STUDY_TESTS_FILE], ignore_index=True),
+        competence=pd.concat(tables["competence"], ignore_index=True),
+        vocal=pd.concat(tables["vocal"], ignore_index=True),
+        study_tests=pd.concat(tables["study_tests"], ignore_index=True),
         configs=configs,
         provenance=pd.DataFrame(where),
     )

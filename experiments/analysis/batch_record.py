@@ -11,9 +11,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from experiments.batch_files import BATCH_FILE
-from experiments.trial_dir import eval_record, storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE, MANIFEST_DIR, is_trial_dir
+from experiments.trial_dir import storage
+from experiments.trial_dir.reading import open_for_reading
 
 
 class RecordMismatch(ValueError):
@@ -70,7 +69,8 @@ def check_not_lost(batch_dir: Path) -> None:
     if (batch_dir / BATCH_FILE).exists() or not batch_dir.is_dir():
         return
     for trial_dir in sorted(batch_dir.iterdir()):
-        if is_trial_dir(trial_dir) and any((trial_dir / MANIFEST_DIR).glob("files-*.json")):
+        trial = open_for_reading(trial_dir)
+        if trial.is_trial() and trial.records_manifest():
             raise RecordMismatch(
                 f"{batch_dir} has no {BATCH_FILE}, though its trials were written by a version "
                 f"that writes one ({trial_dir.name} records a manifest of its files, which no "
@@ -125,10 +125,11 @@ def check_trials_agree(batch_dir: str | os.PathLike, trial_dirs: Iterable[Path])
         return
     found = []
     for trial_dir in trial_dirs:
+        reading = open_for_reading(trial_dir)
         try:
-            config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+            config = reading.config()
             trial = config["trial"]
-            summary = eval_record.read_evaluation(trial_dir, config, "", warn=False)
+            summary = reading.evaluation().summary(config, "", warn=False)
         except (storage.CorruptFileError, OSError, KeyError, TypeError, AttributeError):
             continue  # the reader that needs the file says what is wrong with it
         why = _disagreement(record, trial, summary.get("n_placements"))

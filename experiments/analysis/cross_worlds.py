@@ -19,10 +19,8 @@ from pathlib import Path
 import pandas as pd
 
 from experiments.analysis.logs import trial_dirs
-from experiments.trial_dir import eval_record, manifest, storage
-from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.eval_worlds import own_world
-from experiments.trial_dir.layout import CONFIG_FILE, EVAL_FILE, EVALUATION_TABLES, eval_world_dir
+from experiments.trial_dir.reading import open_for_reading
 
 RINGS = ("ring1", "ring2", "ring3")
 STRATEGIES = ("hand", "tool", "vocal")
@@ -37,20 +35,21 @@ def tested_in(trial_dir: Path, world: str, check: bool = True) -> tuple[dict, st
     MissingTestError where it was not; storage.CorruptFileError for an evaluation whose tables
     are not as its eval.json lists them (unless not `check`: evaluations copied without their
     tables, whose eval.json alone is read)."""
-    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
-    cross = trial_dir / eval_world_dir(world)
-    if (cross / EVAL_FILE).exists():
-        folder, which = cross, "cross"
+    trial = open_for_reading(trial_dir)
+    config = trial.config()
+    cross = trial.evaluation_elsewhere(world)
+    if cross.exists():
+        evaluation, which = cross, "cross"
     elif own_world(config, world):
-        folder, which = trial_dir, "own"
+        evaluation, which = trial.evaluation(), "own"
     else:
         raise MissingTestError(
             f"{trial_dir.name} was not tested in the {world} world: "
             f"`playroom eval {trial_dir} --world {world}`"
         )
-    if not (folder / EVAL_FILE).exists():
+    if not evaluation.exists():
         raise MissingTestError(f"{trial_dir.name} is not evaluated: `playroom eval {trial_dir}`")
-    return checked_summary(trial_dir, folder, config, check), which
+    return checked_summary(trial_dir, evaluation.folder, config, check), which
 
 
 def checked_summary(trial_dir: Path, folder: Path, config: dict, check: bool = True) -> dict:
@@ -58,10 +57,10 @@ def checked_summary(trial_dir: Path, folder: Path, config: dict, check: bool = T
     eval-in-WORLD/), checked against itself and the trial's `config` (experiments/
     eval_record.py) and, if `check`, each table it lists against it. storage.CorruptFileError
     (one line naming the file and what to do) otherwise."""
-    remedy = eval_record.evaluation_remedy(trial_dir, folder)
-    summary = eval_record.read_evaluation(folder, config, remedy)
-    for name in EVALUATION_TABLES if check else ():
-        manifest.read_evaluation_file(folder, name, summary)
+    evaluation = open_for_reading(trial_dir).evaluation(folder)
+    summary = evaluation.summary(config)
+    if check:
+        evaluation.check_tables(summary)
     return summary
 
 

@@ -15,116 +15,50 @@ where they were tested (`eval_world`, `tested_grasp`, `tested_in_own_world`).
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 from pathlib import Path
 
 from experiments.analysis.results import BatchResults, ReportError
 from experiments.analysis.results import collect as collect_own
-from experiments.trial_dir import eval_record, manifest, storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.eval_worlds import (
-    EVAL_WORLDS,
-    OWN,
-    SWITCHES,
-    EvalWorldError,
-    own_world,
-    world_record,
-)
-from experiments.trial_dir.layout import (
-    CONFIG_FILE,
-    EVAL_FILE,
-    EVALUATION_TABLES,
-    eval_world_dir,
-    is_trial_dir,
-)
+from experiments.trial_dir import storage
+from experiments.trial_dir.eval_worlds import EVAL_WORLDS, OWN, EvalWorldError
+from experiments.trial_dir.evaluation import Evaluation, world_remedy
+from experiments.trial_dir.reading import TrialReading, open_for_reading, trials_in
 
 # Trials named in a refusal; more are counted.
 NAMED = 3
 
 
-class EvalWorldMismatch(storage.CorruptFileError):
-    """An evaluation folder of a trial made for another eval world, or as another declaration
-    of it than the one in experiments/trial_dir/eval_worlds.py now (one line)."""
-
-
-def remedy(trial_dir: Path, world: str) -> str:
-    """The command that (re)makes a trial's evaluation in `world`."""
-    return f"`playroom eval {trial_dir} --world {world}` evaluates it there"
-
-
-def evaluation_dir(trial_dir: Path, config: dict, world: str) -> Path:
-    """Where a trial's evaluation in eval world `world` (or OWN) lies: the trial directory
-    for its own world, else its `eval-in-<world>/`. `config`: its config.json, added settings
-    filled in. EvalWorldError for a world unknown or a config that names no preset."""
-    if world == OWN or own_world(config, world):
-        return Path(trial_dir)
-    return Path(trial_dir) / eval_world_dir(world)
-
-
-def check_evaluation(trial_dir: Path, config: dict, world: str, summary: dict) -> None:
-    """storage.CorruptFileError (one line, with `remedy`) unless `summary`, the eval.json of
-    the trial's `eval-in-<world>/`, records `world` as declared now and lists every table of
-    an evaluation, each as it lies there (size and SHA-256)."""
-    folder = Path(trial_dir) / eval_world_dir(world)
-    how = remedy(trial_dir, world)
-    # What makes the world: a world setting added to the project later (and filled in for
-    # older files, experiments/trial_dir/config_file.py) does not make an evaluation stale.
-    expected = json.loads(json.dumps(_identity(world_record(config, world))))
-    recorded = summary.get("eval_world")
-    if not isinstance(recorded, dict) or _identity(recorded) != expected:
-        raise EvalWorldMismatch(
-            f"{folder / EVAL_FILE} is not an evaluation in the {world} world as declared now "
-            f"(experiments/trial_dir/eval_worlds.py): {how}"
-        )
-    listed = summary.get(manifest.EVAL_FILES_KEY)
-    for name in EVALUATION_TABLES:
-        try:
-            size, sha256 = listed[name]  # type: ignore[index]
-            recorded = manifest.Manifest(folder, {name: manifest.Entry(int(size), str(sha256))}, 0)
-        except (KeyError, TypeError, ValueError):
-            raise manifest.DamagedFileError(
-                f"{folder / EVAL_FILE} does not list {name}: {how}"
-            ) from None
-        recorded.read_bytes(folder / name, how)
-
-
-def _identity(record: dict) -> dict:
-    """What makes an eval world of a world record: its name, backend and switches."""
-    world = record.get("world")
-    switches = {s: world.get(s) for s in SWITCHES} if isinstance(world, dict) else None
-    return {"name": record.get("name"), "grasp": record.get("grasp"), "switches": switches}
-
-
-def _config(trial_dir: Path) -> dict:
+def _config(trial: TrialReading) -> dict:
+    """A trial's config.json, added settings filled in; ReportError if it cannot be read."""
     try:
-        config = storage.read_json(trial_dir / CONFIG_FILE)
+        config = trial.config_json()
     except (OSError, storage.CorruptFileError) as exc:
         raise ReportError(" ".join(str(exc).split())) from None
     if not isinstance(config, dict) or not isinstance(config.get("world"), dict):
-        raise ReportError(f"{trial_dir / CONFIG_FILE} holds no trial's settings")
-    return with_added_settings(config)
+        raise ReportError(f"{trial.config_path} holds no trial's settings")
+    return trial.config()
 
 
-def _folder(trial_dir: Path, config: dict, world: str) -> Path:
-    """`evaluation_dir`, ReportError for a trial that cannot be tested in `world`."""
+def _evaluation(trial: TrialReading, world: str) -> Evaluation:
+    """`TrialReading.evaluation_in`, ReportError for a trial that cannot be tested in `world`."""
     try:
-        return evaluation_dir(trial_dir, config, world)
+        return trial.evaluation_in(world)
     except EvalWorldError as exc:
-        raise ReportError(f"{trial_dir}: {exc}") from None
+        raise ReportError(f"{trial.dir}: {exc}") from None
 
 
-def _checked(trial_dir: Path, config: dict, world: str) -> Path:
+def _checked(trial: TrialReading, config: dict, world: str) -> Path:
     """The folder of a trial's evaluation in `world`, its eval.json and tables checked."""
-    folder = _folder(trial_dir, config, world)
-    if folder == trial_dir:  # its own evaluation: results.collect checks it as ever
-        return folder
+    evaluation = _evaluation(trial, world)
+    if evaluation.folder == trial.dir:  # its own evaluation: results.collect checks it as ever
+        return evaluation.folder
     try:
-        summary = eval_record.read_evaluation(folder, config, remedy(trial_dir, world))
-        check_evaluation(trial_dir, config, world, summary)
+        summary = evaluation.summary(config, world_remedy(trial.dir, world))
+        evaluation.check_world(config, world, summary)
     except storage.CorruptFileError as exc:
         raise ReportError(" ".join(str(exc).split())) from None
-    return folder
+    return evaluation.folder
 
 
 def collect(batch_dir: str | os.PathLike, world: str) -> BatchResults:
@@ -135,22 +69,23 @@ def collect(batch_dir: str | os.PathLike, world: str) -> BatchResults:
     batch_dir = Path(batch_dir)
     if world != OWN and world not in EVAL_WORLDS:
         raise ReportError(f"unknown eval world {world!r}: one of {', '.join((OWN, *EVAL_WORLDS))}")
-    listed = batch_dir.iterdir() if batch_dir.is_dir() else iter(())
-    dirs = sorted(d for d in listed if d.is_dir() and is_trial_dir(d))
+    dirs = trials_in(batch_dir) if batch_dir.is_dir() else []
     if world == OWN or not dirs:  # no trials: said as results.collect says it
         return collect_own(batch_dir)
-    configs = {d: _config(d) for d in dirs}
-    missing = [d for d in dirs if not (_folder(d, configs[d], world) / EVAL_FILE).exists()]
+    opened = {d: open_for_reading(d) for d in dirs}
+    configs = {d: _config(opened[d]) for d in dirs}
+    missing = [d for d in dirs if not _evaluation(opened[d], world).exists()]
     if missing:
         shown = ", ".join(d.name for d in missing[:NAMED])
         more = f" and {len(missing) - NAMED} more" if len(missing) > NAMED else ""
+        where = opened[missing[0]].evaluation_elsewhere(world).path.relative_to(missing[0])
         raise ReportError(
             f"{len(missing)} of {len(dirs)} trials in {batch_dir} have no evaluation in the "
-            f"{world} world ({eval_world_dir(world)}/{EVAL_FILE}): {shown}{more}; "
-            f'{remedy(missing[0], world)} (a batch: "eval_worlds": ["{world}"] in its '
+            f"{world} world ({where}): {shown}{more}; "
+            f'{world_remedy(missing[0], world)} (a batch: "eval_worlds": ["{world}"] in its '
             "config, then `playroom batch` again)"
         )
-    folders = {d: _checked(d, configs[d], world) for d in dirs}
+    folders = {d: _checked(opened[d], configs[d], world) for d in dirs}
     results = collect_own(batch_dir, eval_dir=lambda d: folders[d])
     tested = results.trials["trial"].map(lambda name: batch_dir / name)
     trials = results.trials.assign(

@@ -13,7 +13,7 @@ import warnings
 from pathlib import Path
 
 from experiments.trial_dir import storage
-from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE
+from experiments.trial_dir.reading import open_for_reading
 
 # Trials named in a warning; more are counted.
 NAMED = 5
@@ -26,16 +26,16 @@ class IncompleteTrialsWarning(UserWarning):
 def unfinished(trial_dir: str | os.PathLike) -> str | None:
     """None for a trial that ran to its end, else how far it is ("at iteration 200 of 400",
     "no checkpoint yet", "unreadable checkpoint")."""
-    trial_dir = Path(trial_dir)
+    trial = open_for_reading(trial_dir)
     try:
-        config = storage.read_json(trial_dir / CONFIG_FILE)
+        config = trial.config_json()
         total = int(config["trial"]["iterations"])
     except (OSError, storage.CorruptFileError, KeyError, TypeError, ValueError):
-        return "unreadable config.json"
-    if not (trial_dir / CHECKPOINT_FILE).exists():
+        return f"unreadable {trial.config_path.name}"
+    if not trial.has_newest_checkpoint():
         return "no checkpoint yet"
     try:
-        meta = storage.read_meta(trial_dir / CHECKPOINT_FILE)
+        meta = trial.checkpoint_meta()
         iteration, finished = int(meta["iteration"]), bool(meta["finished"])
     except (storage.CorruptFileError, KeyError, TypeError, ValueError):
         return "unreadable checkpoint"

@@ -24,25 +24,9 @@ import pandas as pd
 
 from experiments.analysis.batch_checks import check_batch
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
-from experiments.trial_dir import manifest, storage
-from experiments.trial_dir.config_file import (
-    UnknownSettingError,
-    check_known,
-    trial_identity,
-    with_added_settings,
-)
-from experiments.trial_dir.layout import (
-    CONFIG_FILE,
-    LOST_CHUNK_REMEDY,
-    check_chunk,
-    check_kind,
-    chunk_identity,
-    chunk_paths,
-    is_trial_dir,
-    kind_dir,
-    source_of,
-)
-from experiments.trial_dir.log_schema import SOURCE_COLUMNS, upgraded
+from experiments.trial_dir import manifest
+from experiments.trial_dir.layout import check_kind
+from experiments.trial_dir.reading import open_for_reading, trials_in
 
 
 def read_log(
@@ -63,82 +47,10 @@ def read_log(
     chunk past the newest checkpoint is a running trial's work in progress, not yet vouched
     for: left out. A trial written before manifests is read unchecked, with an
     UncheckedTrialWarning."""
-    frame, checked = _read_log(Path(trial_dir), kind, columns)
+    frame, checked = open_for_reading(trial_dir).log(kind, columns)
     if not checked:
         manifest.warn_unchecked(trial_dir)
     return frame
-
-
-def _read_log(
-    trial_dir: Path, kind: str, columns: Sequence[str] | None
-) -> tuple[pd.DataFrame, bool]:
-    """`read_log`'s frame, and whether the trial's manifest checked it."""
-    check_kind(kind)
-    recorded = manifest.trial_manifest(trial_dir, warn=False)
-    chunks = chunk_paths(trial_dir, kind)
-    if recorded is not None:
-        chunks = _vouched_for(trial_dir, kind, chunks, recorded)
-    if not chunks:
-        return pd.DataFrame(), recorded is not None
-    config_path = trial_dir / CONFIG_FILE
-    config = with_added_settings(storage.read_json(config_path)) if config_path.exists() else None
-    if config is not None:
-        try:
-            check_known(config, config_path)
-        except UnknownSettingError as exc:
-            raise storage.CorruptFileError(str(exc)) from None
-    own = _identity_of(config)
-    wanted = None if columns is None else [*SOURCE_COLUMNS, *columns]
-    frames = []
-    for chunk in chunks.values():
-        data = chunk.read_bytes()
-        if own is None:  # without a config.json, the first chunk's identity is the trial's
-            found = chunk_identity(chunk)
-            own = found if isinstance(found, dict) else None
-        if own is not None:
-            check_chunk(chunk, own, trial_dir)
-        if recorded is not None:
-            recorded.verify(chunk, data, LOST_CHUNK_REMEDY)
-        frames.append(storage.read_table(chunk, wanted, data))
-    frame = pd.concat(frames, ignore_index=True)
-    frame = upgraded(frame, kind, columns)  # an older trial's chunks lack newer columns
-    missing = [c for c in SOURCE_COLUMNS if c not in frame.columns]
-    if missing and config is not None:
-        source = source_of(trial_dir, config)
-        for position, column in enumerate(SOURCE_COLUMNS):
-            if column in missing:
-                frame.insert(position, column, source[column])
-    return frame, recorded is not None
-
-
-def _vouched_for(
-    trial_dir: Path, kind: str, chunks: dict[int, Path], recorded: manifest.Manifest
-) -> dict[int, Path]:
-    """The chunks the trial's newest checkpoint vouches for; manifest.DamagedFileError for one
-    it recorded that is missing, or one before it that it did not record (a stray copy)."""
-    folder = kind_dir(trial_dir, kind)
-    for name in recorded.files:
-        path = trial_dir / name
-        if path.parent == folder and not path.exists():
-            raise manifest.DamagedFileError(f"{path} is missing: {LOST_CHUNK_REMEDY}")
-    kept = {}
-    for start, path in chunks.items():
-        if path in recorded:
-            kept[start] = path
-        elif start < recorded.iteration:
-            raise manifest.DamagedFileError(
-                f"{path} is not among the files the trial's checkpoint recorded (a stray or "
-                f"foreign file?): {LOST_CHUNK_REMEDY}"
-            )
-    return kept
-
-
-def _identity_of(config: dict | None) -> dict | None:
-    """The identity of the trial of a config.json, None without one that names a seed."""
-    try:
-        return None if config is None else trial_identity(config)
-    except (KeyError, TypeError):  # edited by hand: the rows say what they are
-        return None
 
 
 def trial_dirs(batch_dir: str | os.PathLike) -> list[Path]:
@@ -146,7 +58,7 @@ def trial_dirs(batch_dir: str | os.PathLike) -> list[Path]:
     batch_dir = Path(batch_dir)
     if not batch_dir.is_dir():
         raise ValueError(f"{batch_dir} is not a directory")
-    return sorted(d for d in batch_dir.iterdir() if d.is_dir() and is_trial_dir(d))
+    return trials_in(batch_dir)
 
 
 def read_batch_logs(
@@ -172,11 +84,11 @@ def read_batch_logs(
     if incomplete:
         warn_unfinished(batch_dir, incomplete, kept=include_incomplete)
         dirs = dirs if include_incomplete else [d for d in dirs if d not in incomplete]
-    configs = [with_added_settings(storage.read_json(d / CONFIG_FILE)) for d in dirs]
+    configs = [open_for_reading(d).config() for d in dirs]
     check_batch(Path(batch_dir), dirs, configs, frozenset(incomplete))
     frames, unchecked = [], []
     for d in dirs:
-        frame, checked = _read_log(d, kind, None)
+        frame, checked = open_for_reading(d).log(kind, None)
         unchecked += [] if checked else [d.name]
         frames += [] if frame.empty else [frame]
     if unchecked:

@@ -28,23 +28,15 @@ from experiments.analysis.curves import LOG_COLUMNS, curve_rows, tool_numbers
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
-from experiments.trial_dir import backend_record, eval_record, manifest, storage
-from experiments.trial_dir.backend_record import CAPABILITIES
+from experiments.trial_dir import storage
+from experiments.trial_dir.backend_record import CAPABILITIES, study_reach
 from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.eval_record import SCENES_KEY
-from experiments.trial_dir.layout import (
-    COMPETENCE_FILE,
-    CONFIG_FILE,
-    EVAL_FILE,
-    LOG_DIR,
-    STUDY_TESTS_FILE,
-    TIMING_FILE,
-    VOCAL_FILE,
-    is_trial_dir,
-)
+from experiments.trial_dir.evaluation import Evaluation
 from experiments.trial_dir.log_schema import DIVERGED
+from experiments.trial_dir.manifest import UncheckedTrialWarning, warn_unchecked_once
 from experiments.trial_dir.provenance import SHORT_FIELDS
-from experiments.trial_dir.provenance_file import computed_on
+from experiments.trial_dir.reading import TRIAL_MARKS, is_trial, open_for_reading, trials_in
 
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
 
@@ -147,31 +139,28 @@ def read_summary(trial_dir: Path, config: dict, folder: Path | None = None) -> d
     directory), checked against itself and the trial's `config`
     (experiments/trial_dir/eval_record.py); ReportError (one line naming the file and what to do)
     otherwise."""
-    folder = trial_dir if folder is None else folder
-    remedy = eval_record.evaluation_remedy(trial_dir, folder)
     try:
-        return eval_record.read_evaluation(folder, config, remedy)
+        return open_for_reading(trial_dir).evaluation(folder).summary(config)
     except storage.CorruptFileError as exc:
         raise ReportError(" ".join(str(exc).split())) from None
 
 
-def _read_table(path: Path, summary: dict) -> pd.DataFrame | None:
-    """A table of a trial's evaluation, checked against its eval.json (`summary`); None for a
-    table that an evaluation from before it existed lacks."""
+def _read_table(evaluation: Evaluation, kind: str, summary: dict) -> pd.DataFrame | None:
+    """The table of `kind` (evaluation.TABLES) of a trial's evaluation, checked against its
+    eval.json (`summary`); None for a table that an evaluation from before it existed lacks."""
     try:
-        data = manifest.read_evaluation_file(path.parent, path.name, summary)
-        if data is None:
-            return None
-        return storage.read_table(path, data=data)
+        return evaluation.table(kind, summary)
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
 
 
-def _evaluation_table(path: Path, summary: dict) -> pd.DataFrame:
+def _evaluation_table(evaluation: Evaluation, kind: str, summary: dict) -> pd.DataFrame:
     """A table every evaluation writes; ReportError if missing or damaged."""
-    table = _read_table(path, summary)
+    table = _read_table(evaluation, kind, summary)
     if table is None:
-        raise ReportError(f"{path} is missing: evaluate the trial again (`playroom eval`)")
+        raise ReportError(
+            f"{evaluation.table_path(kind)} is missing: evaluate the trial again (`playroom eval`)"
+        )
     return table
 
 
@@ -183,22 +172,24 @@ def _names(paths: list[Path], limit: int = 5) -> str:
 def _trial_dirs(batch_dir: Path, eval_dir: Callable[[Path], Path]) -> list[Path]:
     if not batch_dir.is_dir():
         raise ReportError(f"{batch_dir} is not a directory")
-    if is_trial_dir(batch_dir):
+    if is_trial(batch_dir):
         raise ReportError(
             f"{batch_dir} is a trial directory, not a batch: give the folder that holds trial "
             f"directories (this one is in {batch_dir.resolve().parent})"
         )
-    dirs = sorted(d for d in batch_dir.iterdir() if d.is_dir() and is_trial_dir(d))
+    dirs = trials_in(batch_dir)
     if not dirs:
         raise ReportError(
             f"no trial directories found in {batch_dir}: a batch directory holds one folder per "
-            f"trial (its {CONFIG_FILE} and {LOG_DIR}/), as `playroom batch --out DIR` writes them"
+            f"trial (its {TRIAL_MARKS}), as `playroom batch --out DIR` writes them"
         )
-    missing = [d for d in dirs if not (eval_dir(d) / EVAL_FILE).exists()]
+    evaluations = [open_for_reading(d).evaluation(eval_dir(d)) for d in dirs]
+    missing = [d for d, e in zip(dirs, evaluations, strict=True) if not e.exists()]
     if missing:
         raise ReportError(
-            f"{len(missing)} of {len(dirs)} trials in {batch_dir} have no {EVAL_FILE} "
-            f"(not evaluated): {_names(missing)}; run `playroom eval` on them"
+            f"{len(missing)} of {len(dirs)} trials in {batch_dir} have no "
+            f"{evaluations[0].path.name} (not evaluated): {_names(missing)}; run `playroom eval` "
+            "on them"
         )
     return dirs
 
@@ -245,12 +236,13 @@ def _read_logs(trial_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     except storage.CorruptFileError as exc:
         raise ReportError(str(exc).replace("\n", " ")) from None
     if log.empty:
-        raise ReportError(f"{trial_dir.name} has no iteration log ({LOG_DIR}/iterations/)")
+        where = open_for_reading(trial_dir).log_folder("iterations").relative_to(trial_dir)
+        raise ReportError(f"{trial_dir.name} has no iteration log ({where}/)")
     return log, words
 
 
-def _eval_numbers(trial_dir: Path, summary: dict) -> dict[str, float]:
-    """A trial's numbers from its eval.json."""
+def _eval_numbers(path: Path, summary: dict) -> dict[str, float]:
+    """A trial's numbers from its eval.json (`summary`, read from `path`)."""
     try:
         vocal = summary["vocal"]
         return {
@@ -264,7 +256,7 @@ def _eval_numbers(trial_dir: Path, summary: dict) -> dict[str, float]:
         }
     except (KeyError, TypeError) as exc:
         raise ReportError(
-            f"{trial_dir / EVAL_FILE} lacks {exc}: evaluate the trial again (`playroom eval`)"
+            f"{path} lacks {exc}: evaluate the trial again (`playroom eval`)"
         ) from None
 
 
@@ -274,21 +266,24 @@ def _distance(value: float | None) -> float:
 
 def _timing(trial_dir: Path) -> tuple[float, float]:
     """(seconds, iterations) of timing.json; NaN, NaN when the trial did not record it."""
-    path = trial_dir / TIMING_FILE
-    if not path.exists():
+    trial = open_for_reading(trial_dir)
+    try:
+        timing = trial.timing()
+    except storage.CorruptFileError as exc:
+        raise ReportError(str(exc)) from None
+    if timing is None:
         return math.nan, math.nan
-    timing = _read_json(path)
     try:
         return float(timing["seconds"]), float(timing["iterations"])
     except (KeyError, TypeError, ValueError):
-        raise ReportError(f"{path} lacks 'seconds' and 'iterations' numbers") from None
+        raise ReportError(f"{trial.timing_path} lacks 'seconds' and 'iterations' numbers") from None
 
 
 def _backend(trial_dir: Path, config: dict) -> dict[str, Any]:
     """What the trial's backend declared (experiments/trial_dir/backend_record.py; older trials:
     from their config): its `reach` (m) and capabilities, what it cannot do by construction."""
     try:
-        record = backend_record.read_record(trial_dir, config)
+        record = open_for_reading(trial_dir).backend(config)
     except (storage.CorruptFileError, ValueError) as exc:
         raise ReportError(str(exc)) from None
     return {"reach": float(record["reach"]), **{k: bool(record[k]) for k in CAPABILITIES}}
@@ -298,7 +293,7 @@ def _provenance_rows(d: Path, summary: dict, keys: dict) -> list[dict[str, Any]]
     """Where a trial was computed (provenance.json) and evaluated (eval.json's
     `evaluated_on`): rows of BatchResults.provenance. Trials from before either was recorded
     have rows of status 'not recorded'; the report counts them as such."""
-    rows = [{**keys, "role": "computed", **stretch} for stretch in computed_on(d)]
+    rows = [{**keys, "role": "computed", **s} for s in open_for_reading(d).computed_on()]
     evaluated = summary.get("evaluated_on")
     status = "recorded" if isinstance(evaluated, dict) else "not recorded"
     fields = {k: str(evaluated.get(k, "?")) if evaluated else "" for k in SHORT_FIELDS}
@@ -312,10 +307,12 @@ def _trial_rows(
     """(trials row, competence rows, vocal rows, curve rows, the study's test rows or None) of
     one trial directory, whose evaluation lies in `evaluated`."""
     keys = {"trial": d.name, "group": label, "seed": config["trial"]["seed"]}
-    comp = _evaluation_table(evaluated / COMPETENCE_FILE, summary).assign(**keys)
-    voc = _evaluation_table(evaluated / VOCAL_FILE, summary).assign(**keys)
+    trial = open_for_reading(d)
+    evaluation = trial.evaluation(evaluated)
+    comp = _evaluation_table(evaluation, "competence", summary).assign(**keys)
+    voc = _evaluation_table(evaluation, "vocal", summary).assign(**keys)
     log, words = _read_logs(d)
-    reach = backend_record.study_reach(config["world"])  # one yardstick for every backend
+    reach = study_reach(config["world"])  # one yardstick for every backend
     names = set(voc.loc[voc["is_name"], "word"])
     curve = curve_rows(log, words, config["trial"]["iterations"], names, reach).assign(**keys)
     seconds, timed = _timing(d)
@@ -327,14 +324,14 @@ def _trial_rows(
         "babbling": config["trial"]["babbling"],
         "iterations": config["trial"]["iterations"],
         "n_placements": summary.get("n_placements"),
-        **_eval_numbers(d, summary),
+        **_eval_numbers(trial.evaluation().path, summary),
         "diverged": int(log[DIVERGED].sum()),
         **tool_numbers(log, reach),
         **trial_mechanisms(log, names, set(voc["word"])),
         "seconds": seconds,
         "timed_iterations": timed,
     }
-    study = _read_table(evaluated / STUDY_TESTS_FILE, summary)  # none: evaluated before it
+    study = _read_table(evaluation, "study_tests", summary)  # none: evaluated before it
     study = None if study is None else study.assign(**keys)
     return row, comp, voc, curve, study
 
@@ -350,13 +347,14 @@ def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Pat
         check_trials_agree(batch_dir, dirs)
     except RecordMismatch as exc:
         raise ReportError(str(exc)) from None
-    configs = [_read_json(d / CONFIG_FILE) for d in dirs]
+    trials = [open_for_reading(d) for d in dirs]
+    configs = [_read_json(t.config_path) for t in trials]
     configs = [with_added_settings(c) if isinstance(c, dict) else c for c in configs]
-    for d, config in zip(dirs, configs, strict=True):
+    for trial, config in zip(trials, configs, strict=True):
         if not isinstance(config, dict) or not {"grasp", "babbling", "seed", "iterations"} <= set(
             config.get("trial", {})
         ):
-            raise ReportError(f"{d / CONFIG_FILE} lacks the trial's grasp/babbling/seed")
+            raise ReportError(f"{trial.config_path} lacks the trial's grasp/babbling/seed")
     # Babbling joins the label only when it tells groups apart, to keep labels short.
     mixed = len({c["trial"]["babbling"] for c in configs}) > 1
     labels = [group_label(c["trial"]["grasp"], c["trial"]["babbling"], mixed) for c in configs]
@@ -368,7 +366,7 @@ def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Pat
             raise ReportError(str(exc)) from None
     group_configs: dict[str, dict] = {}
     with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", manifest.UncheckedTrialWarning)
+        warnings.simplefilter("always", UncheckedTrialWarning)
         evals = [read_summary(d, c, eval_dir(d)) for d, c in zip(dirs, configs, strict=True)]
         for label, members in groups.items():
             _check_evaluations(label, [(dirs[i], configs[i], evals[i]) for i in members])
@@ -377,7 +375,7 @@ def collect(batch_dir: str | os.PathLike, eval_dir: Callable[[Path], Path] = Pat
             _trial_rows(d, config, summary, label, eval_dir(d))
             for d, config, summary, label in zip(dirs, configs, evals, labels, strict=True)
         ]
-    manifest.warn_unchecked_once(batch_dir, dirs, caught)
+    warn_unchecked_once(batch_dir, dirs, caught)
     trials, competence, vocal, curves, study = zip(*rows, strict=True)
     where = [
         row

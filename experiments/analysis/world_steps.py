@@ -27,9 +27,7 @@ from experiments.analysis import step_split
 from experiments.analysis.cross_worlds import RINGS, STRATEGIES, checked_summary, tested_in
 from experiments.analysis.logs import trial_dirs
 from experiments.analysis.trial_tests import ALPHA, survives
-from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir.reading import open_for_reading
 
 OWN = "own"
 MEASURES = ("competence_all", "competence_ring1", "competence_ring2", "competence_ring3")
@@ -53,7 +51,7 @@ def evaluations(conditions: dict[str, Path], check: bool = True) -> pd.DataFrame
     rows = []
     for condition, batch_dir in conditions.items():
         for trial in trial_dirs(batch_dir):
-            config = with_added_settings(storage.read_json(trial / CONFIG_FILE))
+            config = open_for_reading(trial).config()
             summary = checked_summary(trial, trial, config, check)
             keys = {"condition": condition, "seed": int(summary["seed"])}
             rows.append({**keys, "tested": OWN, **_numbers(summary)})

@@ -20,7 +20,7 @@ from experiments.baseline.run import policy_file, trained_toys
 from experiments.baseline.settings import BaselineError
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import storage
-from experiments.trial_dir.layout import BASELINE_FILE
+from experiments.trial_dir.baseline_run import open_baseline_run
 from sim.config import config_from_dict
 from sim.vocal.config import VoiceConfig
 
@@ -65,12 +65,13 @@ def tally(
 def run_behaviour(run_dir: str | os.PathLike, episodes: int) -> list[Behaviour]:
     """Every trained toy policy of a baseline run, and random actions on the same episodes."""
     out = Path(run_dir)
-    if not (out / BASELINE_FILE).is_file():
-        raise BaselineError(f"{out} holds no baseline run ({BASELINE_FILE} is missing)")
+    run = open_baseline_run(out)
+    if not run.is_run():
+        raise BaselineError(f"{out} holds no baseline run ({run.record_path.name} is missing)")
     toys = trained_toys(out)  # their files checked against training.json
     if not toys:
         raise BaselineError(f"{out}: no toy policy trained yet")
-    config = storage.read_json(out / BASELINE_FILE)["trial"]
+    config = storage.read_json(run.record_path)["trial"]
     _, room = fresh_trial_parts(config)
     voice = config_from_dict(VoiceConfig, config["voice"])
     grasp = config["trial"]["grasp"]

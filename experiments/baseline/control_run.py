@@ -43,7 +43,7 @@ from experiments.baseline.control_settings import (
 )
 from experiments.baseline.training import library_versions, rl_library
 from experiments.trial_dir import provenance, storage
-from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked, holds_only_lock
 from sim.envs.versions import GOAL_VARIANTS
 
 CONTROL_FILE = "control.json"
@@ -198,7 +198,7 @@ def opened_record(
         except (storage.CorruptFileError, KeyError, TypeError):
             raise error(f"{path} is damaged: remove {out} to run it again") from None
         return record
-    if out.exists() and any(p.name != ".lock" for p in out.iterdir()):
+    if out.exists() and not holds_only_lock(out):
         raise error(f"{out} is not empty and holds no {what}: give another --out")
     record = new()
     storage.write_json(path, record)

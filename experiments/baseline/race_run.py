@@ -49,8 +49,8 @@ from experiments.baseline.race_settings import (
 )
 from experiments.baseline.training import library_versions, rl_library
 from experiments.trial_dir import provenance, storage
-from experiments.trial_dir.layout import CONFIG_FILE
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.reading import open_for_reading
 
 RACE_FILE = "race.json"
 RUNS, TRIALS = "runs", "trials"
@@ -131,7 +131,7 @@ def run_model_babbling(run: RaceRun, trial_dir: Path) -> tuple[list[dict[str, An
         if saved.is_file():  # tested before the run was stopped
             tested = pd.read_csv(saved)
         else:
-            started = (trial_dir / CONFIG_FILE).exists()
+            started = open_for_reading(trial_dir).has_config()
             run_trial(trial_dir, run.trial_at(budget), resume=started, progress=False)
             _, agent, _, meta = load_trial(trial_dir)
             assert meta["iteration"] == budget  # the agent of this budget, not a later one

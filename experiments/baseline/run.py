@@ -38,9 +38,10 @@ from experiments.measure.policy_actor import PolicyActor
 from experiments.measure.trial_evaluation import measured
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import manifest, provenance, storage
+from experiments.trial_dir.baseline_run import open_baseline_run
 from experiments.trial_dir.evaluation import evaluation_files
-from experiments.trial_dir.layout import BASELINE_FILE, EVAL_FILE, TRAINING_FILE
-from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked, holds_only_lock
+from experiments.trial_dir.reading import EVALUATION_MARK
 from sim.config import config_from_dict
 from sim.vocal.config import VoiceConfig
 
@@ -50,13 +51,13 @@ def policy_file(toy: int) -> str:
 
 
 def is_finished(out_dir: str | os.PathLike) -> bool:
-    return (Path(out_dir) / EVAL_FILE).is_file()
+    return open_baseline_run(out_dir).is_finished()
 
 
 def _started(out: Path, settings: BaselineSettings, command: str) -> dict:
     """The run's baseline.json: written for a new run into an empty or new directory, or read
     back and checked against `settings` for one to resume."""
-    path = out / BASELINE_FILE
+    path = open_baseline_run(out).record_path
     config = trial_config(settings)
     if path.exists():
         try:
@@ -75,7 +76,7 @@ def _started(out: Path, settings: BaselineSettings, command: str) -> dict:
                 "give another --out, or the settings it has"
             )
         return recorded
-    if out.exists() and any(p.name != ".lock" for p in out.iterdir()):
+    if out.exists() and not holds_only_lock(out):
         raise BaselineError(f"{out} is not empty and holds no baseline: give another --out")
     record = {
         "learner": {"name": LEARNER, "algorithm": ALGORITHM, "replay_buffer": REPLAY_BUFFER},
@@ -91,7 +92,7 @@ def _started(out: Path, settings: BaselineSettings, command: str) -> dict:
 
 def trained_toys(out: Path) -> dict[str, Any]:
     """training.json's record of the toys done, each checked against its policy file."""
-    path = out / TRAINING_FILE
+    path = open_baseline_run(out).training_path
     if not path.exists():
         return {}
     try:
@@ -122,7 +123,7 @@ def run_baseline(
     out = Path(out_dir)
     if is_finished(out):
         raise BaselineError(
-            f"{out} holds a finished baseline ({EVAL_FILE}): give another --out, or remove it"
+            f"{out} holds a finished baseline ({EVALUATION_MARK}): give another --out, or remove it"
         )
     training.rl_library()  # the extra's absence said before anything is written
     try:
@@ -153,11 +154,12 @@ def run_baseline(
                 entry["libraries"] = training.library_versions()
                 entry["trained_on"] = provenance.short_record(provenance.machine_record())
                 toys[str(toy)] = entry
+                training_json = storage.json_bytes(storage.finite_or_null({"toys": toys}))
                 storage.write_files(
                     out,
                     {
                         policy_file(toy): data,
-                        TRAINING_FILE: storage.json_bytes(storage.finite_or_null({"toys": toys})),
+                        open_baseline_run(out).training_path.name: training_json,
                     },
                 )
         summary = evaluate_baseline(out, settings, record, room, toys, progress)

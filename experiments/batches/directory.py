@@ -16,9 +16,9 @@ from pathlib import Path
 from experiments.batch_files import BATCH_FILE
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.run.trial_config import full_config
-from experiments.trial_dir import eval_record, storage
+from experiments.trial_dir import storage
 from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE, is_trial_dir
+from experiments.trial_dir.reading import TRIAL_MARKS, is_trial, open_for_reading, trials_in
 
 # Fields compared as sets: their order changes only the order trials are listed in.
 _SETS = ("grasps", "babbling", "seeds")
@@ -97,8 +97,9 @@ def _difference(trial_dir: Path, wanted: dict, placements: int) -> str | None:
     """How a trial directory differs from what the batch would write there (`wanted`, its
     config.json; `placements`, its evaluation's), the setting asked for first; None when it
     does not, or when its files cannot be read (its own task then reports the damage)."""
+    trial = open_for_reading(trial_dir)
     try:
-        held = storage.read_json(trial_dir / CONFIG_FILE)
+        held = trial.config_json()
     except (OSError, storage.CorruptFileError):
         return None
     held = with_added_settings(held) if isinstance(held, dict) else {}
@@ -114,7 +115,7 @@ def _difference(trial_dir: Path, wanted: dict, placements: int) -> str | None:
         k, a, b = differences[0]
         return f"{trial_dir.name} was run with {k}={_shown(a)}, this batch runs {_shown(b)}"
     try:  # an evaluation at the trial's end would be kept as the batch's (runner.is_complete)
-        summary = eval_record.read_evaluation(trial_dir, held, "", warn=False)
+        summary = trial.evaluation().summary(held, "", warn=False)
     except (OSError, KeyError, TypeError, storage.CorruptFileError):
         return None  # not kept: evaluated again
     at, n = summary.get("evaluated_at_iteration"), summary.get("n_placements")
@@ -127,7 +128,7 @@ def _difference(trial_dir: Path, wanted: dict, placements: int) -> str | None:
 
 def _check_trials(spec: BatchSpec, out: Path) -> None:
     trials = dict(spec.trials())
-    present = sorted(d for d in out.iterdir() if d.is_dir() and is_trial_dir(d))
+    present = trials_in(out)
     foreign = [d.name for d in present if d.name not in trials]
     if foreign:
         raise BatchError(
@@ -159,10 +160,10 @@ def check_directory(spec: BatchSpec, out: Path) -> None:
     Reads only."""
     if not out.is_dir():
         return
-    if is_trial_dir(out):
+    if is_trial(out):
         raise BatchError(
-            f"{out} is a trial directory (it holds {CONFIG_FILE} and log/), not a batch's: give "
-            "the batch a directory of its own"
+            f"{out} is a trial directory (it holds {TRIAL_MARKS}), not a batch's: give the "
+            "batch a directory of its own"
         )
     _check_record(spec, out)
     _check_trials(spec, out)

@@ -29,7 +29,6 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from experiments.analysis.eval_world_results import check_evaluation
 from experiments.batch_files import BATCH_FILE
 from experiments.batches import scheduler as dask_scheduler
 from experiments.batches import worker_check, workers
@@ -48,20 +47,13 @@ from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run import estimate
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.trial_dir import eval_record, manifest, memory_segments, storage
-from experiments.trial_dir.checkpoint import check_identity
-from experiments.trial_dir.checks import check_files
+from experiments.trial_dir import storage
 from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.eval_worlds import EvalWorldError, own_world
-from experiments.trial_dir.layout import (
-    CHECKPOINT_FILE,
-    CONFIG_FILE,
-    EVALUATION_TABLES,
-    TIMING_FILE,
-    eval_world_dir,
-)
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
+from experiments.trial_dir.reading import open_for_reading
+from experiments.trial_dir.writing import write_timing
 from sim.vocal.diva.data import DivaDataError, DivaDataMissing
 
 # How long a batch task waits for another writer of its trial to finish (s): longer than a
@@ -92,22 +84,23 @@ def is_complete(trial_dir: Path) -> bool:
     """Whether a trial ran to its end, is whole (its own checkpoint, logs complete up to it)
     and was evaluated there: what a rerun may skip. Whatever is not (a truncated eval.json,
     a lost log chunk) is run again, which evaluates it again or reports the damage."""
+    trial = open_for_reading(trial_dir)
     try:
-        config = storage.read_json(trial_dir / CONFIG_FILE)
+        config = trial.config_json()
         # Read whole, with the memory segments it names (a damaged one is run again).
-        _, meta = memory_segments.read_checkpoint(trial_dir / CHECKPOINT_FILE)
+        _, meta = trial.checkpoint_arrays()
         # As recorded and this trial's (eval_record), else evaluated again.
-        summary = eval_record.read_evaluation(trial_dir, config, "", warn=False)
+        evaluation = trial.evaluation()
+        summary = evaluation.summary(config, "", warn=False)
         if not meta.get("finished"):
             return False
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
-        check_identity(trial_dir / CHECKPOINT_FILE, meta, config)
+        trial.check_checkpoint_identity(meta, config)
         # Every file as recorded (manifest, eval.json): a damaged one is run again, which mends
         # what can be mended (backend.json, an evaluation) and names what cannot.
-        check_files(trial_dir, meta, with_added_settings(config))
-        for name in EVALUATION_TABLES:
-            manifest.read_evaluation_file(trial_dir, name, summary)
+        trial.check_files(meta, with_added_settings(config))
+        evaluation.check_tables(summary)
     except (OSError, KeyError, TypeError, storage.CorruptFileError, TrialError):
         return False
     return True
@@ -118,17 +111,19 @@ def eval_world_complete(trial_dir: Path, world: str, placements: int) -> bool:
     the trial's own (its own evaluation is it: `is_complete`), or `eval-in-<world>/` holds an
     evaluation at the trial's last checkpoint, on `placements` placements, of the world as
     declared now, every table as its eval.json lists it."""
+    trial = open_for_reading(trial_dir)
     try:
-        config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+        config = trial.config()
         if own_world(config, world):
             return True
-        summary = eval_record.read_evaluation(trial_dir / eval_world_dir(world), config, "", False)
-        meta = storage.read_meta(trial_dir / CHECKPOINT_FILE)
+        evaluation = trial.evaluation_elsewhere(world)
+        summary = evaluation.summary(config, "", False)
+        meta = trial.checkpoint_meta()
         if summary.get("n_placements") != placements:
             return False
         if summary.get("evaluated_at_iteration") != meta["iteration"]:
             return False
-        check_evaluation(trial_dir, config, world, summary)
+        evaluation.check_world(config, world, summary)
     except (OSError, KeyError, TypeError, storage.CorruptFileError, EvalWorldError):
         return False
     return True
@@ -165,7 +160,8 @@ def _own_part_complete(path: Path, placements: int) -> dict | None:
     `placements` placements, else None."""
     if not is_complete(path):
         return None
-    summary = eval_record.read_evaluation(path, storage.read_json(path / CONFIG_FILE), "", False)
+    trial = open_for_reading(path)
+    summary = trial.evaluation().summary(trial.config_json(), "", False)
     return summary if summary.get("n_placements") == placements else None
 
 
@@ -201,7 +197,7 @@ def _run_and_evaluate(
         # A rerun that only asks for eval worlds: the trial and its own evaluation are kept.
         summary = _own_part_complete(path, eval_placements)
         if summary is None:
-            resume = (path / "config.json").exists()
+            resume = open_for_reading(path).has_config()
             trial = run_trial(
                 path, settings, resume=resume, progress=False,
                 report=reporter(progress_topic, path.name, report_interval_s),
@@ -209,13 +205,7 @@ def _run_and_evaluate(
             )  # fmt: skip
             if trial.elapsed is not None:
                 # Only the iterations run now are timed: resumed trials still give a fair cost.
-                storage.write_json(
-                    path / TIMING_FILE,
-                    {
-                        "seconds": trial.elapsed,
-                        "iterations": settings.iterations - trial.start_iteration,
-                    },
-                )
+                write_timing(path, trial.elapsed, settings.iterations - trial.start_iteration)
             summary = evaluate_trial(path, evaluation)
         tested = {}
         for world in eval_worlds:

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from experiments.trial_dir import manifest
-from experiments.trial_dir.layout import CHECKPOINT_FILE, MANIFEST_DIR, MEMORY_DIR, manifest_name
-from experiments.trial_dir.memory_segments import AGENT, read_checkpoint
+from experiments.trial_dir.memory_segments import AGENT
+from experiments.trial_dir.reading import open_for_reading
 from learner.memory import TREE_ROWS, NearestNeighbourMemory
 from learner.sensorimotor_model import MODELS, ModelSpec
 from models.layout import BLOCK_DIM
@@ -114,7 +114,7 @@ def query_figures(
     and their mean over the models that hold rows (random babbling's choice). Then how the
     query grows: each model of at least 4 x TREE_ROWS rows, on its first 2 x TREE_ROWS x 2^k
     rows, as it was when it held them."""
-    arrays, _ = read_checkpoint(trial / CHECKPOINT_FILE)
+    arrays, _ = open_for_reading(trial).checkpoint_arrays()
     rng = np.random.default_rng(0)
     keys = {s.number: arrays[f"{AGENT}model{s.number}.key"] for s in MODELS}
     held = [spec for spec in MODELS if len(keys[spec.number])]
@@ -165,7 +165,7 @@ def _time_queries(memory: NearestNeighbourMemory, queries: np.ndarray) -> float:
 
 
 def _segment(trial: Path, start: int) -> Path:
-    return trial / MEMORY_DIR / f"rows-{start:08d}.npz"
+    return open_for_reading(trial).segment_path(start)
 
 
 def _cost(trial: Path, start: int, window: int) -> float:
@@ -177,6 +177,6 @@ def _cost(trial: Path, start: int, window: int) -> float:
 def _checkpoint_bytes(trial: Path, start: int) -> int:
     """What one checkpoint writes there: the period's segment, its manifest file and a
     checkpoint (the final one's size: a checkpoint's size does not grow with the trial)."""
-    end = start + PERIOD
-    files = (_segment(trial, start), trial / MANIFEST_DIR / manifest_name(end))
-    return sum(p.stat().st_size for p in files) + (trial / CHECKPOINT_FILE).stat().st_size
+    end, reading = start + PERIOD, open_for_reading(trial)
+    files = (_segment(trial, start), reading.manifest_path(end), reading.checkpoint_path)
+    return sum(p.stat().st_size for p in files)

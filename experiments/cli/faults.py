@@ -23,7 +23,6 @@ import sys
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from pathlib import Path
 
 from experiments.cli.args import UsageError
 from experiments.run import stop_requests
@@ -94,21 +93,15 @@ def _command(argv: list[str], add: str | None = None, drop: str | None = None) -
 def _run_kept(args: argparse.Namespace, argv: list[str], then: str) -> str:
     """What an interrupted or failed `playroom run` kept, and the command that continues it
     (`then`: what to do first, e.g. "free some space, then ")."""
-    from experiments.trial_dir import storage
-    from experiments.trial_dir.layout import CHECKPOINT_FILE, CONFIG_FILE, PREVIOUS_CHECKPOINT_FILE
+    from experiments.trial_dir.reading import open_for_reading
 
-    out = Path(args.out)
-    if not (out / CONFIG_FILE).exists():  # stopped before the trial was set up
+    trial = open_for_reading(args.out)
+    if not trial.has_config():  # stopped before the trial was set up
         again = _command(argv, drop="--resume")
         return f"nothing of the trial was kept; {then}start it again with: {again}"
-    for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
-        if (out / name).exists():
-            try:
-                iteration = storage.read_meta(out / name)["iteration"]
-            except (storage.CorruptFileError, KeyError, TypeError):
-                continue
-            kept = f"the trial is kept up to its checkpoint at iteration {iteration}"
-            break
+    iteration = trial.kept_iteration()
+    if iteration is not None:
+        kept = f"the trial is kept up to its checkpoint at iteration {iteration}"
     else:
         kept = "the trial had no checkpoint yet"
     return f"{kept}; {then}resume with: {_command(argv, add='--resume')}"

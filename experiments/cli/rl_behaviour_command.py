@@ -35,18 +35,17 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_dirs(given: list[str]) -> list[Path]:
-    from experiments.trial_dir.layout import BASELINE_FILE
+    from experiments.trial_dir.baseline_run import BASELINE_RUN_MARK, open_baseline_run
+
+    def is_run(path: Path) -> bool:
+        return open_baseline_run(path).is_run()
 
     dirs: list[Path] = []
     for name in given:
         path = Path(name)
-        found = (
-            [path]
-            if (path / BASELINE_FILE).is_file()
-            else sorted(p for p in path.glob("*") if (p / BASELINE_FILE).is_file())
-        )
+        found = [path] if is_run(path) else sorted(p for p in path.glob("*") if is_run(p))
         if not found:
-            raise UsageError(f"{name} holds no run of playroom rl-baseline ({BASELINE_FILE})")
+            raise UsageError(f"{name} holds no run of playroom rl-baseline ({BASELINE_RUN_MARK})")
         dirs += found
     return dirs
 

@@ -195,8 +195,8 @@ def cmd_eval(args: argparse.Namespace) -> None:
     from experiments.measure.trial_evaluation import evaluate_trial
     from experiments.trial_dir import storage
     from experiments.trial_dir.errors import TrialError
-    from experiments.trial_dir.layout import eval_world_dir
     from experiments.trial_dir.provenance_file import computed_on_line
+    from experiments.trial_dir.reading import open_for_reading
 
     try:
         summary = evaluate_trial(
@@ -218,7 +218,8 @@ def cmd_eval(args: argparse.Namespace) -> None:
         f"{summary['evaluated_at_iteration']} iterations{where}"
     )
     if tested is not None:
-        print(f"  written into {os.path.join(args.dir, eval_world_dir(tested['name']))}")
+        folder = open_for_reading(args.dir).evaluation_elsewhere(tested["name"]).folder
+        print(f"  written into {os.path.join(args.dir, folder.name)}")
     print(f"  {computed_on_line(args.dir)}")
     print(
         "  normalised competence (0% = random agent, 100% = perfect): "

@@ -34,11 +34,10 @@ from experiments.measure.evaluation import (
     goal_trajectory,
     scene_placements,
 )
-from experiments.run.trial_parts import load_trial
-from experiments.trial_dir import eval_record, manifest, storage
+from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.eval_record import SCENES_KEY
-from experiments.trial_dir.layout import COMPETENCE_FILE, EVAL_FILE
+from experiments.trial_dir.reading import EVALUATION_MARK, open_for_reading
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom
@@ -97,11 +96,12 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
     """`replay_table` of the first `n_trials` finished trials of each backend of a batch."""
     tables = []
     for grasp in GRASPS:
-        dirs = sorted(d for d in batch_dir.glob(f"{grasp}-*") if (d / EVAL_FILE).exists())
-        for trial_dir in dirs[:n_trials]:
-            config, agent, room, _ = load_trial(trial_dir)
-            remedy = eval_record.evaluation_remedy(trial_dir, trial_dir)
-            summary = eval_record.read_evaluation(trial_dir, config, remedy)
+        trials = [open_for_reading(d) for d in sorted(batch_dir.glob(f"{grasp}-*"))]
+        for trial in [t for t in trials if t.evaluation().exists()][:n_trials]:
+            trial_dir = trial.dir
+            config, agent, room, _ = trial.restored(fresh_trial_parts)
+            evaluation = trial.evaluation()
+            summary = evaluation.summary(config)
             # The evaluation's scenes (its placements), and the random command it played on
             # each of them beside the replays.
             settings = EvaluationSettings(
@@ -111,15 +111,14 @@ def replay_batch(batch_dir: Path, n_trials: int) -> pd.DataFrame:
             table = replay_table(agent, room, settings)
             if table.empty:  # no arm test chosen by a model (an untrained agent)
                 continue
-            data = manifest.read_evaluation_file(trial_dir, COMPETENCE_FILE, summary)
-            evaluated = storage.read_table(trial_dir / COMPETENCE_FILE, data=data)
+            evaluated = evaluation.required_table("competence", summary)
             random = evaluated[evaluated["ring"] == 1][["placement", "toy", "random_error"]]
             table = table.merge(random, on=["placement", "toy"], how="left")
             tables.append(table.assign(trial=trial_dir.name, grasp=grasp))
     if not tables:
         raise TrialError(
             f"{batch_dir} holds no finished trial whose agent chose an arm movement in ring 1 "
-            f"(a trial folder with {EVAL_FILE}, past its random bootstrap)"
+            f"(a trial folder with {EVALUATION_MARK}, past its random bootstrap)"
         )
     return pd.concat(tables, ignore_index=True)
 

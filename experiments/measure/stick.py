@@ -25,8 +25,7 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE, is_trial_dir
+from experiments.trial_dir.reading import open_for_reading, trials_in
 from models.layout import ARM_DIM, N_STEPS, TOYS
 from models.presets import DEFAULT_PRESET
 from models.world import Feedback
@@ -108,12 +107,10 @@ def batch_worlds(batch_dirs: Iterable[str | os.PathLike]) -> dict[str, dict]:
     of the batch names them)."""
     worlds: dict[str, dict] = {}
     for batch_dir in map(Path, batch_dirs):
-        trials = (
-            sorted(d for d in batch_dir.iterdir() if is_trial_dir(d)) if batch_dir.is_dir() else []
-        )
+        trials = trials_in(batch_dir) if batch_dir.is_dir() else []
         for trial_dir in trials:
             try:
-                config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+                config = open_for_reading(trial_dir).config()
                 worlds.setdefault(config["trial"]["grasp"], config["world"])
             except (OSError, storage.CorruptFileError, KeyError, TypeError, AttributeError):
                 continue

@@ -29,8 +29,8 @@ from matplotlib.figure import Figure
 from experiments.analysis.curves import falling_rate_distance, grasp_rate_by_distance
 from experiments.analysis.logs import read_log
 from experiments.report.figures import group_colour, png_bytes
-from experiments.trial_dir import backend_record, provenance, storage
-from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.reading import open_for_reading
 
 # The proposal's rule (falling_rate_distance): the first 1 cm bin beyond the start pose's whose
 # grasp rate is below half of the start's, among bins of at least 100 arm movements.
@@ -55,12 +55,13 @@ def batch_rates(batch_dir: Path, bin_width: float = BIN_WIDTH) -> BatchRates:
     logs: dict[str, list[pd.DataFrame]] = {}
     configs: dict[str, dict] = {}
     records: dict[str, dict] = {}
-    for config_path in sorted(batch_dir.glob(f"*/{CONFIG_FILE}")):
-        config = storage.read_json(config_path)
+    # Every folder with a config.json, in order.
+    for trial in (t for t in map(open_for_reading, sorted(batch_dir.iterdir())) if t.has_config()):
+        config = trial.config_json()
         grasp = config["trial"]["grasp"]
-        logs.setdefault(grasp, []).append(read_log(config_path.parent))
+        logs.setdefault(grasp, []).append(read_log(trial.dir))
         configs[grasp] = config
-        records[grasp] = backend_record.read_record(config_path.parent, config)
+        records[grasp] = trial.backend(config)
     rates = {g: grasp_rate_by_distance(pd.concat(ls), bin_width) for g, ls in logs.items()}
     return BatchRates(rates, configs, records, {g: len(ls) for g, ls in logs.items()})
 

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from experiments.run.settings import TrialSettings
-from experiments.trial_dir.checkpoint import progress
 from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.reading import open_for_reading
 
 # Seconds of an iteration, by grasp backend: 5293 and 559 iterations a second over trials of
 # 5000 iterations (docs/speed.md, `playroom bench trial`, which measures every registered
@@ -84,7 +84,7 @@ def check_fits(out_dir: Path, settings: TrialSettings, resume: bool) -> str | No
     """TrialError (one line) if the trial's files will not fit on the disk of `out_dir`, with
     what it holds there already; else the line that states a long trial's costs (trials longer
     than LONG_TRIAL iterations, with iterations left to run), or None."""
-    start, held = progress(out_dir) if resume else (0, 0)
+    start, held = open_for_reading(out_dir).progress() if resume else (0, 0)
     costs = trial_costs(settings, start)
     free = _free_space(_existing(out_dir))
     need = costs.disk_bytes - held
@@ -118,7 +118,7 @@ def check_batch_fits(out_dir: Path, trials: list[tuple[Path, TrialSettings]]) ->
     batch's costs (its trials' seconds, if one process ran them all, and disk), or None."""
     costs, held = [], 0
     for trial_dir, settings in trials:
-        start, on_disk = progress(trial_dir) if trial_dir.is_dir() else (0, 0)
+        start, on_disk = open_for_reading(trial_dir).progress() if trial_dir.is_dir() else (0, 0)
         costs.append(trial_costs(settings, start))
         held += on_disk
     need = sum(c.disk_bytes for c in costs) - held

@@ -14,10 +14,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from experiments.trial_dir import storage
 from experiments.trial_dir.config_file import WORLD_CHOICES
 from experiments.trial_dir.errors import TrialError
-from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir.reading import open_for_reading
 from learner.config import BABBLING_MODES, LearnerConfig
 from models.checks import INT64_MAX, check_seed
 from models.presets import DEFAULT_PRESET, PRESETS
@@ -154,13 +153,14 @@ def resume_settings(out_dir: str | os.PathLike, given: dict[str, Any]) -> TrialS
 
 def stored_settings(out_dir: str | os.PathLike) -> TrialSettings:
     """The TrialSettings a trial directory's config.json holds; TrialError when there is none."""
-    path = Path(out_dir) / CONFIG_FILE
+    stored = open_for_reading(out_dir)
+    path = stored.config_path
     if not Path(out_dir).is_dir():
         why = "not a directory" if Path(out_dir).exists() else "no such directory"
         raise TrialError(f"no trial to resume in {out_dir}: {why}")
     if not path.is_file():
-        raise TrialError(f"no trial to resume in {out_dir}: it holds no {CONFIG_FILE}")
-    config = storage.read_json(path)
+        raise TrialError(f"no trial to resume in {out_dir}: it holds no {path.name}")
+    config = stored.config_json()
     trial = config.get("trial") if isinstance(config, dict) else None
     if not isinstance(trial, dict):
         raise TrialError(f'{path} holds no trial settings (no "trial" section)')

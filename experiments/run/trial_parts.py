@@ -11,7 +11,6 @@ import os
 import numpy as np
 
 from experiments.trial_dir.errors import TrialConfigError
-from experiments.trial_dir.layout import CONFIG_FILE
 from experiments.trial_dir.log_schema import (
     CAREGIVER_SAID,
     DIVERGED,
@@ -99,7 +98,7 @@ def fresh_trial_parts(config: dict) -> tuple[Agent, Playroom]:
             LearnerConfig.from_dict(config["learner"]),
         )
     except (KeyError, TypeError, ValueError) as exc:
-        raise TrialConfigError(f"{CONFIG_FILE} makes no trial: {exc}") from None
+        raise TrialConfigError.making_no_trial(exc) from None
 
 
 def trial_parts(

@@ -3,6 +3,8 @@ saying why (the command line prints it as it is, exit code 2)."""
 
 from __future__ import annotations
 
+from experiments.trial_dir.layout import CONFIG_FILE
+
 
 class TrialError(Exception):
     """A trial directory or setting that cannot be used; the message says why."""
@@ -11,6 +13,11 @@ class TrialError(Exception):
 class TrialConfigError(TrialError, ValueError):
     """A config.json no trial can be made from: a TrialError (one line, exit code 2) and a
     ValueError, as the configs raise for it (callers catching either keep working)."""
+
+    @classmethod
+    def making_no_trial(cls, exc: Exception) -> TrialConfigError:
+        """The error for a config.json whose settings made the configs raise `exc`."""
+        return cls(f"{CONFIG_FILE} makes no trial: {exc}")
 
 
 class TrialLocked(TrialError):

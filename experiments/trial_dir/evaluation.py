@@ -73,6 +73,13 @@ class Evaluation:
         data = manifest.read_evaluation_file(self.folder, path.name, summary)
         return None if data is None else storage.read_table(path, data=data)
 
+    def required_table(self, kind: str, summary: dict) -> pd.DataFrame:
+        """`table`, for a table every evaluation wrote: one missing is a
+        storage.CorruptFileError whichever evaluation it is."""
+        path = self.table_path(kind)
+        data = manifest.read_evaluation_file(self.folder, path.name, summary)
+        return storage.read_table(path, data=data)
+
     def check_tables(self, summary: dict) -> None:
         """manifest.DamagedFileError unless every table eval.json (`summary`) lists is as it
         lists it."""

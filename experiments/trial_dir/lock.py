@@ -32,6 +32,12 @@ def _holder_text(holder: str) -> str:
     return f"pid {pid} on {host}" if host else f"pid {pid}"
 
 
+def holds_only_lock(directory: Path) -> bool:
+    """Whether a directory holds nothing but a writer's lock (a run killed before it wrote
+    anything leaves that): a directory to use again, not something else's."""
+    return all(p.name == LOCK_FILE for p in directory.iterdir())
+
+
 class DirectoryLocked(Exception):
     """Another process writes into the directory; the message names it and its process id."""
 

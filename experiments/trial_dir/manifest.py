@@ -279,6 +279,11 @@ def write_period(
     return {"name": name, "sha256": entry_of(data).sha256}
 
 
+def recorded_any(trial_dir: str | os.PathLike) -> bool:
+    """Whether a trial directory holds any manifest file."""
+    return any((Path(trial_dir) / MANIFEST_DIR).glob("files-*.json"))
+
+
 def drop_past(trial_dir: Path, iteration: int) -> None:
     """Delete the manifest files of checkpoints past `iteration` (written by a run killed
     before its checkpoint, or past the checkpoint a resume falls back to): the run writes them

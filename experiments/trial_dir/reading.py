@@ -38,15 +38,24 @@ from experiments.trial_dir.layout import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
     CONFIG_FILE,
+    EVAL_FILE,
+    LOG_DIR,
+    MANIFEST_DIR,
+    MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
     TIMING_FILE,
     is_trial_dir,
+    kind_dir,
+    manifest_name,
+    memory_segment_name,
 )
 from experiments.trial_dir.log_reading import read_log_checked
 from experiments.trial_dir.provenance_file import computed_on
 
-# What marks a folder as a trial directory, as messages say it.
-TRIAL_MARKS = "its config.json and log/"
+# What marks a folder as a trial directory (layout.is_trial_dir), as messages say it.
+TRIAL_MARKS = f"{CONFIG_FILE} and {LOG_DIR}/"
+# What marks a trial as evaluated (its eval.json), as messages say it.
+EVALUATION_MARK = EVAL_FILE
 
 
 @dataclass
@@ -62,6 +71,14 @@ class TrialReading:
     def config_path(self) -> Path:
         """config.json, as messages name it."""
         return self.dir / CONFIG_FILE
+
+    def has_config(self) -> bool:
+        """Whether config.json is there (a folder of a trial, or of one being made)."""
+        return self.config_path.exists()
+
+    def no_trial_line(self) -> str:
+        """What a reader says of a folder without config.json: it holds no trial."""
+        return f"{self.dir} holds no trial ({CONFIG_FILE} is missing)"
 
     def is_trial(self) -> bool:
         """Whether the folder is a trial directory (`playroom run` wrote its config.json and
@@ -94,13 +111,30 @@ class TrialReading:
         checked it, False for a trial from before manifests, which the caller says)."""
         return read_log_checked(self.dir, kind, columns)
 
+    def log_folder(self, kind: str) -> Path:
+        """The folder of one kind of log, as messages name it."""
+        return kind_dir(self.dir, kind)
+
     # The checkpoint ------------------------------------------------------------------------
     def has_checkpoint(self) -> bool:
         """Whether it holds a checkpoint, the newest or the previous one."""
         return checkpoint.has_checkpoint(self.dir)
 
+    @property
+    def checkpoint_path(self) -> Path:
+        """The newest checkpoint, as messages and measures name it."""
+        return self.dir / CHECKPOINT_FILE
+
     def has_newest_checkpoint(self) -> bool:
-        return (self.dir / CHECKPOINT_FILE).exists()
+        return self.checkpoint_path.exists()
+
+    def segment_path(self, start: int) -> Path:
+        """The memory segment of the checkpoint period that starts at iteration `start`."""
+        return self.dir / MEMORY_DIR / memory_segment_name(start)
+
+    def manifest_path(self, iteration: int) -> Path:
+        """The manifest file of the checkpoint at `iteration`."""
+        return self.dir / MANIFEST_DIR / manifest_name(iteration)
 
     def checkpoint_meta(self) -> dict:
         """The newest checkpoint's metadata, its arrays not read (storage.CorruptFileError if it
@@ -116,6 +150,11 @@ class TrialReading:
         """TrialError if the newest checkpoint (of metadata `meta`) is another trial's."""
         checkpoint.check_identity(self.dir / CHECKPOINT_FILE, meta, config)
 
+    def records_manifest(self) -> bool:
+        """Whether it records a manifest of its files (manifest.py), which every version since
+        manifests writes, whatever its checkpoints say."""
+        return manifest.recorded_any(self.dir)
+
     def check_files(self, meta: dict, config: dict) -> manifest.Manifest | None:
         """TrialError unless the logs and backend.json a checkpoint of metadata `meta` covers
         are whole and as recorded (checks.check_files); the manifest, None before manifests."""
@@ -129,8 +168,8 @@ class TrialReading:
         TrialError unless its newest checkpoint is its own and readable, and its logs up to it,
         its memory segments and backend.json whole and as its manifest recorded them: what is
         derived from it (an evaluation, a report) would not be the trial's."""
-        if not self.config_path.exists():
-            raise TrialError(f"{self.dir} holds no trial ({CONFIG_FILE} is missing)")
+        if not self.has_config():
+            raise TrialError(self.no_trial_line())
         if not self.has_checkpoint():
             raise TrialError(f"{self.dir} has no checkpoint yet")
         try:
@@ -151,6 +190,17 @@ class TrialReading:
         if check_files(self.dir, meta, config) is None:
             manifest.warn_unchecked(self.dir)
         return config, agent, room, meta
+
+    def kept_iteration(self) -> object | None:
+        """The iteration its newest readable checkpoint records (the newest, else the previous
+        one), as recorded; None without one."""
+        for name in (CHECKPOINT_FILE, PREVIOUS_CHECKPOINT_FILE):
+            if (self.dir / name).exists():
+                try:
+                    return storage.read_meta(self.dir / name)["iteration"]
+                except (storage.CorruptFileError, KeyError, TypeError):
+                    continue
+        return None
 
     def progress(self) -> tuple[int, int]:
         """(iteration of the newest readable checkpoint, bytes it holds on disk): checkpoint.py."""

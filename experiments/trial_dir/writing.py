@@ -8,7 +8,8 @@ what a writer does to a trial directory, decided and recorded here, so that it n
   it, backend.json and provenance.json.
 - `open_for_evaluation(trial_dir)`: the trial's derived files, under its lock
   (`EvaluationWriter`): the trial restored and checked whole, a killed writer's litter removed,
-  its evaluation in a world written as one unit, eval.json last.
+  its evaluation in a world written as one unit, eval.json last; and the batch task's timing
+  (`write_timing`).
 
 Order on disk, for crash safety: a period's chunks and memory segment, then its manifest file,
 then the checkpoint that names it (manifest.py, memory_segments.py). No simulator is loaded:
@@ -35,9 +36,9 @@ from experiments.trial_dir.layout import (
     BACKEND_FILE,
     CHECKPOINT_FILE,
     CHUNK_IDENTITY_KEY,
-    CONFIG_FILE,
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
+    TIMING_FILE,
     chunk_path,
 )
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
@@ -220,7 +221,7 @@ def open_for_evaluation(trial_dir: str | os.PathLike) -> EvaluationWriter:
     or whose lock cannot be made or opened for writing (read-only)."""
     trial = TrialReading(Path(trial_dir))
     if not trial.config_path.is_file():  # the lock would make the folder
-        raise TrialError(f"{trial.dir} holds no trial ({CONFIG_FILE} is missing)")
+        raise TrialError(trial.no_trial_line())
     try:
         lock = DirectoryLock(trial.dir).acquire()
     except DirectoryLocked as exc:
@@ -228,3 +229,12 @@ def open_for_evaluation(trial_dir: str | os.PathLike) -> EvaluationWriter:
     except OSError as exc:  # the lock file cannot be made or opened for writing: read-only
         raise TrialError(f"cannot write into {trial.dir}: {storage.reason(exc)}") from None
     return EvaluationWriter(trial, lock)
+
+
+def write_timing(trial_dir: str | os.PathLike, seconds: float, iterations: int) -> None:
+    """timing.json, derived from the trial's last run: its `seconds` and the `iterations` they
+    ran (a resumed trial's, those of this run only: a fair cost). Written by the batch task
+    that ran the trial, under its lock."""
+    storage.write_json(
+        Path(trial_dir) / TIMING_FILE, {"seconds": seconds, "iterations": iterations}
+    )

@@ -18,10 +18,8 @@ from tqdm import tqdm
 
 from experiments.analysis.logs import read_log
 from experiments.run.trial_parts import fresh_trial_parts, log_row
-from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE
 from experiments.trial_dir.log_schema import ITERATION, STICK_GRASPED, TOY_MOVED_BY, WORD_RECOGNISED
+from experiments.trial_dir.reading import open_for_reading
 from experiments.video.episodes import (
     EpisodeRenderer,
     check_output_path,
@@ -90,8 +88,9 @@ def render_trial(
     Returns the MP4's path and, per filmed iteration, its logged and replayed log rows.
     """
     trial_dir = Path(trial_dir)
-    if not (trial_dir / CONFIG_FILE).exists():
-        raise ReplayError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
+    trial = open_for_reading(trial_dir)
+    if not trial.has_config():
+        raise ReplayError(trial.no_trial_line())
     out = check_output_path(out_path)
     size = parse_size(size)
     log = read_log(trial_dir)
@@ -111,7 +110,7 @@ def render_trial(
             raise ReplayError(
                 f"iterations {bad} are out of range: the trial logged 0..{len(log) - 1}"
             )
-    config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
+    config = trial.config()
     agent, room = fresh_trial_parts(config)
     voice_audio, word_audio = tract_audio(room)
     logged_rows = log.set_index(ITERATION)

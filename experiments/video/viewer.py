@@ -11,15 +11,12 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from experiments.run.trial_parts import fresh_trial_parts
-from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.layout import CONFIG_FILE
+from experiments.trial_dir.reading import open_for_reading
 from models.layout import ARM_DIM, VOICE_DIM
 from models.presets import DEFAULT_PRESET
 from models.world import Feedback
@@ -123,10 +120,10 @@ def view_trial(trial_dir: str | os.PathLike, start: int, count: int, pace: float
     """A trial's iterations `start` .. `start + count - 1`, shown live after replaying the
     earlier ones unseen (the replay is exact: the same agent, the same room, the same draws);
     returns how many were shown."""
-    path = Path(trial_dir) / CONFIG_FILE
-    if not path.is_file():
-        raise ViewError(f"{trial_dir} holds no trial ({CONFIG_FILE} is missing)")
-    config = with_added_settings(storage.read_json(path))
+    trial = open_for_reading(trial_dir)
+    if not trial.config_path.is_file():
+        raise ViewError(trial.no_trial_line())
+    config = trial.config()
     total = int(config["trial"]["iterations"])
     if not 0 <= start < total:
         raise ViewError(f"--from {start} is out of range: the trial has 0..{total - 1}")

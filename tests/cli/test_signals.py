@@ -194,7 +194,7 @@ def test_a_stop_raised_inside_a_finalizer_still_stops_the_run(tmp_path, monkeypa
     """Python drops an exception raised in a `__del__` (pyarrow's ParquetWriter has one, run
     after each log chunk): the stop it carried is raised again at the next iteration."""
     from experiments.cli.main import main
-    from experiments.run import trial as trial_module
+    from experiments.trial_dir import writing
 
     class SignalsWhenCollected:
         def __del__(self) -> None:
@@ -202,13 +202,13 @@ def test_a_stop_raised_inside_a_finalizer_still_stops_the_run(tmp_path, monkeypa
             for _ in range(1000):  # the handler runs here, inside the finalizer
                 time.sleep(0.0001)
 
-    write_table = trial_module.storage.write_table
+    write_table = writing.storage.write_table
 
     def write_then_collect(*args, **kwargs):
         write_table(*args, **kwargs)
         SignalsWhenCollected()  # collected at once: the signal arrives in its __del__
 
-    monkeypatch.setattr(trial_module.storage, "write_table", write_then_collect)
+    monkeypatch.setattr(writing.storage, "write_table", write_then_collect)
     dropped: list = []  # what Python drops: exceptions raised in finalizers
     monkeypatch.setattr(sys, "unraisablehook", dropped.append)
     out = tmp_path / "trial"
