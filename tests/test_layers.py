@@ -30,12 +30,13 @@ SIM_SETTINGS = (
         ("import experiments.analysis.stats", SIMULATOR),
         ("import experiments.report.comparison", SIMULATOR),
         ("from experiments.analysis.logs import read_log, read_batch_logs", SIMULATOR),
-        # The trial directory's package, whole: its layout, schema, records, checks and
-        # checkpoint restore (into an agent and room the run's stage builds).
+        # The trial directory's package, whole: its two faces, its layout, schema, records,
+        # checks and checkpoint restore (into an agent and room the run's stage builds).
         (
             "import experiments.trial_dir.layout, experiments.trial_dir.log_schema, "
             "experiments.trial_dir.backend_record, experiments.trial_dir.checks, "
-            "experiments.trial_dir.opening",
+            "experiments.trial_dir.opening, experiments.trial_dir.reading, "
+            "experiments.trial_dir.writing",
             SIMULATOR,
         ),
         # Naming and checking the grasp backends imports none of them.
