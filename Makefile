@@ -269,11 +269,15 @@ rl-control: $(RL_INSTALLED)
 ## settings), one policy of the three toys, on the trials of experiments/batches/rl-baseline/
 ## comparison.json (both backends, 8 seeds x 20000 movements), all tested on the same 300
 ## held-out toy goals every 2000 (`playroom rl-race`, on every core; docs/rl-race.md: its
-## cost), then its tables, record and figure copied into docs/; rerunning resumes
+## cost), then Model Babbling's trials asked again by the toy's start and end
+## (`playroom rl-race-lookup`), then the tables, record and figure copied into docs/; rerunning
+## resumes
 RL_RACE := $(OUT)/rl-race
 rl-race: $(RL_INSTALLED)
 	$(BIN)/playroom rl-race --out $(RL_RACE) --config $(RL_BASELINE)
+	$(BIN)/playroom rl-race-lookup $(RL_RACE)
 	mkdir -p docs/data
+	cp $(RL_RACE)/rl-race-lookup.csv $(RL_RACE)/rl-race-lookup-summary.csv docs/data/
 	cp $(RL_RACE)/rl-race.csv $(RL_RACE)/rl-race-claims.csv $(RL_RACE)/rl-race.json docs/data/
 	cp $(RL_RACE)/rl-race.png docs/rl-race.png
 

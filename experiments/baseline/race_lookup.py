@@ -21,7 +21,7 @@ import pandas as pd
 
 from experiments.baseline import race_learners as rl
 from experiments.baseline.race_claims import paired_p
-from experiments.baseline.race_run import ALL_RINGS, TRIALS
+from experiments.baseline.race_run import TRIALS, ring_shares
 from experiments.baseline.race_settings import FIRST_HELD_OUT_SEED, RaceError
 from experiments.trial_dir import storage
 from learner.agent import Agent
@@ -65,19 +65,8 @@ def start_end_lookup_act(agent: Agent) -> rl.Act:
 
 
 def _rows(grasp: str, seed: int, steps: int, question: str, tested: pd.DataFrame) -> list[dict]:
-    rows = []
-    for ring, goals in (*tested.groupby("ring"), (ALL_RINGS, tested)):
-        share = float(goals["reached"].mean())
-        rows.append(
-            dict(
-                zip(
-                    LOOKUP_COLUMNS,
-                    (grasp, seed, steps, question, ring, len(goals), share),
-                    strict=True,
-                )
-            )
-        )
-    return rows
+    own = (grasp, seed, steps, question)
+    return [dict(zip(LOOKUP_COLUMNS, (*own, *share), strict=True)) for share in ring_shares(tested)]
 
 
 def race_lookup(race_dir: str | Path) -> pd.DataFrame:

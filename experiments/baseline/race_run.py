@@ -59,23 +59,22 @@ COLUMNS = ["learner", "grasp", "seed", "steps", "ring", "goals", "success"]
 ALL_RINGS = "all"
 
 
+def ring_shares(tested: pd.DataFrame) -> list[tuple[str, int, float]]:
+    """A test's share of goals reached, near, far and in all: (ring, goals, success) rows."""
+    return [
+        (str(ring), len(goals), float(goals["reached"].mean()))
+        for ring, goals in (*tested.groupby("ring"), (ALL_RINGS, tested))
+    ]
+
+
 def curve_rows(run: RaceRun, steps: int, tested: pd.DataFrame) -> list[dict[str, Any]]:
     """A test's rows: the share of held-out goals reached, near, far and in all (`goals`: the
     movements tested, several a goal for random commands)."""
-    rows = []
-    for ring, goals in (*tested.groupby("ring"), (ALL_RINGS, tested)):
-        rows.append(
-            {
-                "learner": run.learner,
-                "grasp": run.trial.grasp,
-                "seed": run.trial.seed,
-                "steps": steps,
-                "ring": ring,
-                "goals": len(goals),
-                "success": float(goals["reached"].mean()),
-            }
-        )
-    return rows
+    own = {"learner": run.learner, "grasp": run.trial.grasp, "seed": run.trial.seed, "steps": steps}
+    return [
+        {**own, "ring": ring, "goals": goals, "success": success}
+        for ring, goals, success in ring_shares(tested)
+    ]
 
 
 def _env(run: RaceRun, motor: str | None = None) -> Any:

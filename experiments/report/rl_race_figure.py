@@ -15,6 +15,10 @@ from experiments.report.figures import png_bytes
 # Each learner's colour, in the order given (Model Babbling's first).
 COLOURS = ("tab:green", "tab:orange", "tab:blue", "tab:grey")
 RINGS = ("near", "far", "all")
+# The y axis ends this far above the highest success drawn (a share of it), and never below
+# FLOOR_PERCENT: success near 0 everywhere would otherwise be flat lines on a 0-100 axis.
+HEADROOM = 1.15
+FLOOR_PERCENT = 1.0
 
 
 def race_figure(table: pd.DataFrame, learners: Sequence[str]) -> Figure:
@@ -24,6 +28,7 @@ def race_figure(table: pd.DataFrame, learners: Sequence[str]) -> Figure:
     grasps = list(dict.fromkeys(table["grasp"]))
     fig = Figure(figsize=(4.2 * len(RINGS), 3.2 * len(grasps)), layout="constrained")
     axes = fig.subplots(len(grasps), len(RINGS), squeeze=False, sharey=True)
+    top = min(100.0, max(FLOOR_PERCENT, HEADROOM * 100 * float(table["success"].max())))
     for row, grasp in zip(axes, grasps, strict=True):
         for ax, ring in zip(row, RINGS, strict=True):
             rows = table[(table["grasp"] == grasp) & (table["ring"] == ring)]
@@ -37,7 +42,7 @@ def race_figure(table: pd.DataFrame, learners: Sequence[str]) -> Figure:
                 ax.plot(mean.index, 100 * mean.to_numpy(), color=colour, lw=2.0, label=label)
             ax.set_title(f"{grasp} grasp, {ring} goals", fontsize=9)
             ax.set_xlabel("movements given")
-            ax.set_ylim(-2, 102)
+            ax.set_ylim(-0.02 * top, top)
         row[0].set_ylabel("held-out toy goals reached (%)")
     axes[0][0].legend(fontsize=7, loc="upper left")
     return fig
