@@ -13,24 +13,101 @@
 
 from __future__ import annotations
 
+import json
 import os
+import re
 from pathlib import Path
 
 from experiments.trial_dir import manifest, storage
-from experiments.trial_dir.config_file import trial_identity, with_added_settings
+from experiments.trial_dir.config_file import identity_text, trial_identity
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     BACKEND_FILE,
-    CONFIG_FILE,
+    CHUNK_IDENTITY_KEY,
+    LOG_CHUNK_PREFIX,
+    LOG_DIR,
     LOG_KINDS,
     LOST_CHUNK_REMEDY,
-    DuplicateChunkError,
-    ForeignChunkError,
-    check_chunk,
-    chunk_path,
-    chunk_paths,
+    OLD_LOG_CHUNK_PATTERN,
+    chunk_file,
+    kind_folder,
 )
 from experiments.trial_dir.log_schema import WORDS_LOG_PERIOD
+
+# The names of the chunks of both layouts (layout.py's docstring).
+_CHUNK = re.compile(re.escape(LOG_CHUNK_PREFIX) + r"(?P<start>[0-9]{8})\.parquet")
+_OLD_CHUNK = re.compile(OLD_LOG_CHUNK_PATTERN)
+
+
+# Where pandas keeps a table's attrs in the Parquet schema's metadata (to_parquet, read_parquet).
+_PANDAS_ATTRS = b"PANDAS_ATTRS"
+
+
+class DuplicateChunkError(storage.CorruptFileError):
+    """A chunk found in both layouts: which one is the trial's cannot be told."""
+
+
+class ForeignChunkError(storage.CorruptFileError):
+    """A chunk that carries another trial's identity than the trial it lies in."""
+
+
+def chunk_identity(path: Path) -> object:
+    """The identity a chunk carries (as written: a dict, unless someone wrote another thing),
+    or None for a chunk written before chunks carried one. CorruptFileError if unreadable."""
+    import pyarrow.parquet as pq  # imported where used, as storage.py does
+
+    try:
+        metadata = pq.read_schema(path).metadata or {}
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise storage.CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
+    try:
+        attrs = json.loads(metadata.get(_PANDAS_ATTRS, b"{}"))
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        return "unreadable"  # not the trial's own writing: never taken as its identity
+    return attrs.get(CHUNK_IDENTITY_KEY) if isinstance(attrs, dict) else "unreadable"
+
+
+def check_chunk(path: Path, own: dict, trial_dir: str | os.PathLike) -> None:
+    """ForeignChunkError (one line, naming the chunk and both identities) if the chunk at
+    `path` carries another identity than `own`, its trial's; a chunk without one passes."""
+    found = chunk_identity(path)
+    if found is not None and found != own:
+        raise ForeignChunkError(
+            f"{path} belongs to another trial ({identity_text(found)}) than {trial_dir} "
+            f"({identity_text(own)}); refusing to mix them"
+        )
+
+
+def old_chunks(trial_dir: str | os.PathLike) -> list[tuple[str, int, Path]]:
+    """(kind, start, path) of every chunk of the old layout (side by side in log/)."""
+    log = Path(trial_dir) / LOG_DIR
+    found = []
+    for path in sorted(log.glob("*.parquet")):
+        match = _OLD_CHUNK.fullmatch(path.name)
+        if match is not None:
+            found.append((match["kind"], int(match["start"]), path))
+    return found
+
+
+def chunk_paths(trial_dir: str | os.PathLike, kind: str) -> dict[int, Path]:
+    """Every chunk of one kind of log, by the iteration it starts at, in order, from both
+    layouts. DuplicateChunkError (one line, naming both) for a chunk found in both."""
+    chunks: dict[int, Path] = {}
+    folder = Path(trial_dir) / kind_folder(kind)
+    for path in folder.glob("*.parquet"):
+        match = _CHUNK.fullmatch(path.name)
+        if match is not None:
+            chunks[int(match["start"])] = path
+    for found_kind, start, path in old_chunks(trial_dir):
+        if found_kind != kind:
+            continue
+        if start in chunks:
+            raise DuplicateChunkError(
+                f"{chunks[start]} and {path} both hold the {kind} from iteration {start}: keep "
+                "the trial's own one (the other may be a stray copy) and remove the other"
+            )
+        chunks[start] = path
+    return dict(sorted(chunks.items()))
 
 
 def check_files(trial_dir: Path, meta: dict, config: dict) -> manifest.Manifest | None:
@@ -74,11 +151,11 @@ def checked_chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
 def check_logs(
     trial_dir: str | os.PathLike,
     iteration: int,
-    config: dict | None = None,
+    config: dict,
     recorded: manifest.Manifest | None = None,
 ) -> None:
     """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
-    is missing, unreadable, of another trial than `config`'s (the trial's config.json if None),
+    is missing, unreadable, of another trial than `config`'s (its config.json, settings added),
     not as the checkpoint's manifest (`recorded`, None for a trial from before manifests)
     recorded it, not recorded there, or holds other rows than its name and period say: the
     iterations chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
@@ -86,8 +163,6 @@ def check_logs(
     work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of both
     layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
     trial_dir = Path(trial_dir)
-    if config is None:
-        config = with_added_settings(storage.read_json(trial_dir / CONFIG_FILE))
     own = trial_identity(config)
     found = {
         kind: {s: p for s, p in checked_chunks(trial_dir, kind).items() if s < iteration}
@@ -100,7 +175,7 @@ def check_logs(
     start = 0
     while start < iteration:
         if start not in found["iterations"]:
-            path = chunk_path(trial_dir, "iterations", start)
+            path = trial_dir / chunk_file("iterations", start)
             end = min((s for s in found["iterations"] if s > start), default=iteration)
             raise TrialError(_lost(f"{path} is missing (iterations {start} to {end - 1})"))
         path = found["iterations"][start]
@@ -111,7 +186,7 @@ def check_logs(
         reached = range(
             (start // WORDS_LOG_PERIOD + 1) * WORDS_LOG_PERIOD, end + 1, WORDS_LOG_PERIOD
         )
-        words = found["words"].pop(start, chunk_path(trial_dir, "words", start))
+        words = found["words"].pop(start, trial_dir / chunk_file("words", start))
         if reached and not words.exists():
             raise TrialError(_lost(f"{words} is missing (words at {reached[0]} to {reached[-1]})"))
         if words.exists():
@@ -155,39 +230,3 @@ def _first_line(exc: Exception) -> str:
 def _lost(problem: str) -> str:
     """One line: a log chunk that is not whole (`problem` names it), and the only ways back."""
     return f"{problem}: {LOST_CHUNK_REMEDY}; nothing was changed"
-
-
-def _alive(pid: int) -> bool:
-    """Whether a process `pid` runs on this machine."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's
-        return True
-    return True
-
-
-def is_litter(name: str) -> bool:
-    """Whether a file named `name` is a temporary file of a writer that no longer runs."""
-    pid = storage.temporary_writer(name)
-    return pid is not None and not _alive(pid)
-
-
-def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
-    """Remove the temporary files that writers killed mid-write (storage.write_bytes) left in a
-    trial directory, wherever they lie in it (its memory/, log/, manifest/, an eval world's
-    folder...); returns their paths relative to the directory.
-
-    Called under the directory's lock: every writer of the trial's own files (run, eval, a
-    batch task) holds it, so such a file there was left by a dead writer. A live process is
-    still spared: a writer that takes no lock (a video rendered into the directory) may own
-    it. A spared file is never taken for a result either (experiments/run/trial.py's derived
-    files leave temporary files out)."""
-    trial_dir = Path(trial_dir)
-    removed = []
-    for path in sorted(trial_dir.rglob(".*.tmp")):
-        if is_litter(path.name):
-            path.unlink(missing_ok=True)
-            removed.append(path.relative_to(trial_dir).as_posix())
-    return removed

@@ -53,13 +53,10 @@ Names, and pure functions of paths and dicts, reading only: no simulator, no lea
 
 from __future__ import annotations
 
-import json
 import os
-import re
 from pathlib import Path
 
-from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import identity_text, with_added_settings
+from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.log_schema import SOURCE_COLUMNS
 
 # The trial itself -----------------------------------------------------------------------
@@ -178,54 +175,14 @@ def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int
     return dict(zip(SOURCE_COLUMNS, values, strict=True))
 
 
-_CHUNK = re.compile(re.escape(LOG_CHUNK_PREFIX) + r"(?P<start>[0-9]{8})\.parquet")
-_OLD_CHUNK = re.compile(OLD_LOG_CHUNK_PATTERN)
-
-
 # The key of a chunk's table attrs that holds its trial's identity, and where pandas keeps a
 # table's attrs in the Parquet schema's metadata (DataFrame.to_parquet, read_parquet).
 CHUNK_IDENTITY_KEY = "playroom.trial"
-_PANDAS_ATTRS = b"PANDAS_ATTRS"
 # What a user can do about a log chunk that is missing, damaged or foreign: said after it.
 LOST_CHUNK_REMEDY = (
     "the logs of a trial cannot be regenerated except by running it again from scratch (into "
     "a new directory, with the settings in its config.json) or restored from a backup"
 )
-
-
-class DuplicateChunkError(storage.CorruptFileError):
-    """A chunk found in both layouts: which one is the trial's cannot be told."""
-
-
-class ForeignChunkError(storage.CorruptFileError):
-    """A chunk that carries another trial's identity than the trial it lies in."""
-
-
-def chunk_identity(path: Path) -> object:
-    """The identity a chunk carries (as written: a dict, unless someone wrote another thing),
-    or None for a chunk written before chunks carried one. CorruptFileError if unreadable."""
-    import pyarrow.parquet as pq  # imported where used, as storage.py does
-
-    try:
-        metadata = pq.read_schema(path).metadata or {}
-    except Exception as exc:  # pyarrow raises several types for damaged files
-        raise storage.CorruptFileError(f"{path} is damaged or truncated ({exc})") from None
-    try:
-        attrs = json.loads(metadata.get(_PANDAS_ATTRS, b"{}"))
-    except (UnicodeDecodeError, json.JSONDecodeError):
-        return "unreadable"  # not the trial's own writing: never taken as its identity
-    return attrs.get(CHUNK_IDENTITY_KEY) if isinstance(attrs, dict) else "unreadable"
-
-
-def check_chunk(path: Path, own: dict, trial_dir: str | os.PathLike) -> None:
-    """ForeignChunkError (one line, naming the chunk and both identities) if the chunk at
-    `path` carries another identity than `own`, its trial's; a chunk without one passes."""
-    found = chunk_identity(path)
-    if found is not None and found != own:
-        raise ForeignChunkError(
-            f"{path} belongs to another trial ({identity_text(found)}) than {trial_dir} "
-            f"({identity_text(own)}); refusing to mix them"
-        )
 
 
 def check_kind(kind: str) -> None:
@@ -234,47 +191,17 @@ def check_kind(kind: str) -> None:
         raise ValueError(f"unknown log kind {kind!r}: one of {', '.join(LOG_KINDS)}")
 
 
-def kind_dir(trial_dir: str | os.PathLike, kind: str) -> Path:
-    """The folder of one kind of log of a trial."""
+def kind_folder(kind: str) -> str:
+    """The folder of one kind of log, relative to the trial directory (a name: the reader or
+    writer joins it to the directory)."""
     check_kind(kind)
-    return Path(trial_dir) / LOG_DIR / kind
+    return f"{LOG_DIR}/{kind}"
 
 
-def chunk_path(trial_dir: str | os.PathLike, kind: str, start: int) -> Path:
-    """Where the chunk of `kind` that starts at iteration `start` is written."""
-    return kind_dir(trial_dir, kind) / log_chunk_name(start)
-
-
-def old_chunks(trial_dir: str | os.PathLike) -> list[tuple[str, int, Path]]:
-    """(kind, start, path) of every chunk of the old layout (side by side in log/)."""
-    log = Path(trial_dir) / LOG_DIR
-    found = []
-    for path in sorted(log.glob("*.parquet")):
-        match = _OLD_CHUNK.fullmatch(path.name)
-        if match is not None:
-            found.append((match["kind"], int(match["start"]), path))
-    return found
-
-
-def chunk_paths(trial_dir: str | os.PathLike, kind: str) -> dict[int, Path]:
-    """Every chunk of one kind of log, by the iteration it starts at, in order, from both
-    layouts. DuplicateChunkError (one line, naming both) for a chunk found in both."""
-    chunks: dict[int, Path] = {}
-    folder = kind_dir(trial_dir, kind)
-    for path in folder.glob("*.parquet"):
-        match = _CHUNK.fullmatch(path.name)
-        if match is not None:
-            chunks[int(match["start"])] = path
-    for found_kind, start, path in old_chunks(trial_dir):
-        if found_kind != kind:
-            continue
-        if start in chunks:
-            raise DuplicateChunkError(
-                f"{chunks[start]} and {path} both hold the {kind} from iteration {start}: keep "
-                "the trial's own one (the other may be a stray copy) and remove the other"
-            )
-        chunks[start] = path
-    return dict(sorted(chunks.items()))
+def chunk_file(kind: str, start: int) -> str:
+    """Where the chunk of `kind` that starts at iteration `start` is written, relative to the
+    trial directory."""
+    return f"{kind_folder(kind)}/{log_chunk_name(start)}"
 
 
 def is_trial_dir(directory: str | os.PathLike) -> bool:

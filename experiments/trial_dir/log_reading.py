@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from experiments.trial_dir import manifest, storage
+from experiments.trial_dir.checks import check_chunk, chunk_identity, chunk_paths
 from experiments.trial_dir.config_file import (
     UnknownSettingError,
     check_known,
@@ -21,11 +22,8 @@ from experiments.trial_dir.config_file import (
 from experiments.trial_dir.layout import (
     CONFIG_FILE,
     LOST_CHUNK_REMEDY,
-    check_chunk,
     check_kind,
-    chunk_identity,
-    chunk_paths,
-    kind_dir,
+    kind_folder,
     source_of,
 )
 from experiments.trial_dir.log_schema import SOURCE_COLUMNS, upgraded
@@ -91,7 +89,7 @@ def _vouched_for(
 ) -> dict[int, Path]:
     """The chunks the trial's newest checkpoint vouches for; manifest.DamagedFileError for one
     it recorded that is missing, or one before it that it did not record (a stray copy)."""
-    folder = kind_dir(trial_dir, kind)
+    folder = Path(trial_dir) / kind_folder(kind)
     for name in recorded.files:
         path = trial_dir / name
         if path.parent == folder and not path.exists():

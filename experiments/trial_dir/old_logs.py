@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from experiments.trial_dir import storage
-from experiments.trial_dir.layout import chunk_path, old_chunks, source_of
+from experiments.trial_dir.checks import old_chunks
+from experiments.trial_dir.layout import chunk_file, source_of
 from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 
 
@@ -33,7 +34,7 @@ def move_old_chunks(trial_dir: Path, config: dict) -> int:
     source = source_of(trial_dir, config)
     moved = 0
     for kind, start, path in old_chunks(trial_dir):
-        target = chunk_path(trial_dir, kind, start)
+        target = Path(trial_dir) / chunk_file(kind, start)
         target.parent.mkdir(exist_ok=True)
         try:
             table = storage.read_table(path)

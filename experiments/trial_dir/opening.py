@@ -24,7 +24,7 @@ import numpy as np
 
 from experiments.trial_dir import manifest, memory_segments, storage
 from experiments.trial_dir.checkpoint import A, Build, R
-from experiments.trial_dir.checks import is_litter, remove_litter
+from experiments.trial_dir.checks import chunk_paths
 from experiments.trial_dir.config_file import (
     EXTENSIBLE,
     UnknownSettingError,
@@ -41,11 +41,11 @@ from experiments.trial_dir.layout import (
     LOG_README_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
-    chunk_paths,
     source_of,
 )
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from experiments.trial_dir.resume import prepare_resume
+from experiments.trial_dir.storage import is_litter, remove_litter
 
 # What a trial counts as it runs (its checkpoints keep them; `playroom run` prints them).
 COUNTS = ("tool_uses", "words_recognised", "diverged", "stick_returns")

@@ -45,7 +45,7 @@ from experiments.trial_dir.layout import (
     PREVIOUS_CHECKPOINT_FILE,
     TIMING_FILE,
     is_trial_dir,
-    kind_dir,
+    kind_folder,
     manifest_name,
     memory_segment_name,
 )
@@ -113,7 +113,7 @@ class TrialReading:
 
     def log_folder(self, kind: str) -> Path:
         """The folder of one kind of log, as messages name it."""
-        return kind_dir(self.dir, kind)
+        return self.dir / kind_folder(kind)
 
     # The checkpoint ------------------------------------------------------------------------
     def has_checkpoint(self) -> bool:

@@ -11,12 +11,7 @@ from pathlib import Path
 
 from experiments.trial_dir import manifest, memory_segments
 from experiments.trial_dir.checkpoint import A, Build, R, restore_newest
-from experiments.trial_dir.checks import (
-    check_logs,
-    checked_chunks,
-    recorded_manifest,
-    remove_litter,
-)
+from experiments.trial_dir.checks import check_logs, checked_chunks, recorded_manifest
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
@@ -25,6 +20,7 @@ from experiments.trial_dir.layout import (
     PREVIOUS_CHECKPOINT_FILE,
 )
 from experiments.trial_dir.old_logs import move_old_chunks
+from experiments.trial_dir.storage import remove_litter
 
 
 def prepare_resume(

@@ -329,3 +329,39 @@ def config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, An
         elif va != vb:
             out.append((f"{prefix}{k}", va, vb))
     return out
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process `pid` runs on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        return True
+    return True
+
+
+def is_litter(name: str) -> bool:
+    """Whether a file named `name` is a temporary file of a writer that no longer runs."""
+    pid = temporary_writer(name)
+    return pid is not None and not _alive(pid)
+
+
+def remove_litter(trial_dir: str | os.PathLike) -> list[str]:
+    """Remove the temporary files that writers killed mid-write (storage.write_bytes) left in a
+    trial directory, wherever they lie in it (its memory/, log/, manifest/, an eval world's
+    folder...); returns their paths relative to the directory.
+
+    Called under the directory's lock: every writer of the trial's own files (run, eval, a
+    batch task) holds it, so such a file there was left by a dead writer. A live process is
+    still spared: a writer that takes no lock (a video rendered into the directory) may own
+    it. A spared file is never taken for a result either (experiments/run/trial.py's derived
+    files leave temporary files out)."""
+    trial_dir = Path(trial_dir)
+    removed = []
+    for path in sorted(trial_dir.rglob(".*.tmp")):
+        if is_litter(path.name):
+            path.unlink(missing_ok=True)
+            removed.append(path.relative_to(trial_dir).as_posix())
+    return removed

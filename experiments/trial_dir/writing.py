@@ -29,7 +29,6 @@ import pandas as pd
 
 from experiments.trial_dir import backend_record, manifest, memory_segments, storage
 from experiments.trial_dir.checkpoint import A, Build, R
-from experiments.trial_dir.checks import remove_litter
 from experiments.trial_dir.errors import TrialError, TrialLocked
 from experiments.trial_dir.evaluation import Evaluation, evaluation_files
 from experiments.trial_dir.layout import (
@@ -39,13 +38,14 @@ from experiments.trial_dir.layout import (
     MEMORY_DIR,
     PREVIOUS_CHECKPOINT_FILE,
     TIMING_FILE,
-    chunk_path,
+    chunk_file,
 )
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from experiments.trial_dir.log_schema import SOURCE_COLUMNS
 from experiments.trial_dir.opening import OpenedTrial, open_trial_directory
 from experiments.trial_dir.provenance_file import record_start
 from experiments.trial_dir.reading import TrialReading
+from experiments.trial_dir.storage import remove_litter
 
 
 class Checkpointed(memory_segments.Memories, Protocol):
@@ -107,7 +107,7 @@ class TrialWriter(Generic[A, R]):
         trial's identity; recorded by the next checkpoint's manifest."""
         for position, column in enumerate(SOURCE_COLUMNS):
             table.insert(position, column, self.opened.source[column])
-        path = chunk_path(self.dir, kind, start)
+        path = self.dir / chunk_file(kind, start)
         path.parent.mkdir(exist_ok=True)
         # Written into the Parquet schema's metadata (layout.py).
         table.attrs[CHUNK_IDENTITY_KEY] = self.opened.identity

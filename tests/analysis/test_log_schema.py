@@ -17,7 +17,7 @@ from experiments.analysis.curves import curve_rows, grasp_rate_by_distance, tool
 from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LABELS, trial_mechanisms
 from experiments.trial_dir import storage
-from experiments.trial_dir.layout import CONFIG_FILE, chunk_path
+from experiments.trial_dir.layout import CONFIG_FILE, chunk_file
 from experiments.trial_dir.log_schema import (
     GOAL_COLUMNS,
     ITERATION,
@@ -58,7 +58,7 @@ def _trial(tmp_path: Path, *chunks: pd.DataFrame) -> Path:
     storage.write_json(trial / CONFIG_FILE, {**CONFIG, "trial": {**CONFIG["trial"], "seed": 11}})
     start = 0
     for chunk in chunks:
-        path = chunk_path(trial, "iterations", start)
+        path = Path(trial) / chunk_file("iterations", start)
         path.parent.mkdir(parents=True, exist_ok=True)
         storage.write_table(path, chunk)
         start += len(chunk)

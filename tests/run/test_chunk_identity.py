@@ -20,6 +20,7 @@ from experiments.cli.main import main
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.trial_dir import storage
+from experiments.trial_dir.checks import chunk_identity
 from experiments.trial_dir.config_file import trial_identity
 from experiments.trial_dir.layout import (
     CHUNK_IDENTITY_KEY,
@@ -27,7 +28,6 @@ from experiments.trial_dir.layout import (
     LOCK_FILE,
     LOG_DIR,
     LOG_KINDS,
-    chunk_identity,
 )
 
 TOTAL, PERIOD = 300, 100
