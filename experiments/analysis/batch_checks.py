@@ -10,7 +10,7 @@ import json
 from pathlib import Path
 
 from experiments.analysis.batch_record import RecordMismatch, check_trials_agree
-from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import config_differences
 
 
 class BatchMismatch(ValueError):
@@ -44,7 +44,7 @@ def check_group(label: str, dirs: list[Path], configs: list[dict]) -> None:
     """BatchMismatch unless every setting but the seed agrees and the seeds are distinct."""
     reference = shared_config(configs[0])
     for d, config in zip(dirs[1:], configs[1:], strict=True):
-        differences = storage.config_differences(reference, shared_config(config))
+        differences = config_differences(reference, shared_config(config))
         if differences:
             key, a, b = differences[0]  # the first is enough to find the culprit
             raise BatchMismatch(

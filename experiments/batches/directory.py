@@ -17,7 +17,7 @@ from experiments.batch_files import BATCH_FILE
 from experiments.batches.spec import BatchError, BatchSpec, spec_record
 from experiments.run.trial_config import full_config
 from experiments.trial_dir import storage
-from experiments.trial_dir.config_file import with_added_settings
+from experiments.trial_dir.config_file import config_differences, with_added_settings
 from experiments.trial_dir.reading import TRIAL_MARKS, is_trial, open_for_reading, trials_in
 
 # Fields compared as sets: their order changes only the order trials are listed in.
@@ -104,11 +104,7 @@ def _difference(trial_dir: Path, wanted: dict, placements: int) -> str | None:
         return None
     held = with_added_settings(held) if isinstance(held, dict) else {}
     differences = sorted(
-        (
-            (k, a, b)
-            for k, a, b in storage.config_differences(held, wanted)
-            if k not in _NOT_SETTINGS
-        ),
+        ((k, a, b) for k, a, b in config_differences(held, wanted) if k not in _NOT_SETTINGS),
         key=lambda d: not d[0].startswith("trial."),  # the setting asked for, not its effects
     )
     if differences:

@@ -49,6 +49,7 @@ from experiments.report.figures import STRATEGY_COLOURS, png_bytes
 from experiments.report.measures import Measure, registry
 from experiments.report.pages import pct
 from experiments.trial_dir import storage
+from experiments.trial_dir.config_file import config_differences
 
 # How a batch recorded its settings' origin, not a setting: left out of the rows' labels.
 BOOKKEEPING = ("trial.preset", "trial.overrides")
@@ -62,7 +63,7 @@ def describe_change(baseline: dict, config: dict) -> str:
     """The settings that differ between two group configs, as `key: before -> after`."""
     changes = [
         change
-        for change in storage.config_differences(baseline, config)
+        for change in config_differences(baseline, config)
         if not any(change[0] == key or change[0].startswith(f"{key}.") for key in BOOKKEEPING)
         and change[0] not in MIRRORED
     ]

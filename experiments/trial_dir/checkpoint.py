@@ -18,7 +18,7 @@ from typing import Any, Protocol, TypeVar
 import numpy as np
 
 from experiments.trial_dir import memory_segments, storage
-from experiments.trial_dir.config_file import identity_text, trial_identity
+from experiments.trial_dir.config_file import identity_text
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
@@ -46,11 +46,11 @@ R = TypeVar("R", bound=RoomState)
 Build = Callable[[], tuple[A, R]]
 
 
-def check_identity(path: Path, meta: dict, config: dict) -> None:
-    """TrialError if the checkpoint at `path` belongs to another trial than `config`'s.
-    A checkpoint without identity (written before checkpoints carried one) is taken as the
-    trial's: the caller says so where it can."""
-    found, own = meta.get("identity"), trial_identity(config)
+def check_identity(path: Path, meta: dict, own: dict) -> None:
+    """TrialError if the checkpoint at `path` belongs to another trial than the one of identity
+    `own` (config_file.trial_identity). A checkpoint without identity (written before
+    checkpoints carried one) is taken as the trial's: the caller says so where it can."""
+    found = meta.get("identity")
     if found is None or found == own:
         return
     raise TrialError(
@@ -65,17 +65,17 @@ def restore_checkpoint(
     room: RoomState,
     name: str = CHECKPOINT_FILE,
     *,
-    config: dict,
+    identity: dict,
 ) -> dict:
     """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`;
     returns the checkpoint's metadata with 'best_word_distance' added. CorruptFileError if it
     or a segment cannot be read or restored; TrialError if either belongs to another trial
-    than `config`'s."""
+    than the one of `identity`."""
     path = Path(trial_dir) / name
     if not path.exists():
         raise storage.CorruptFileError(f"{path} is missing")
     arrays, meta = storage.read_arrays(path)
-    check_identity(path, meta, config)
+    check_identity(path, meta, identity)
     try:
         arrays = memory_segments.with_rows(path, arrays, meta)
     except memory_segments.ForeignSegmentError as exc:
@@ -93,7 +93,7 @@ def restore_checkpoint(
 
 def restore_newest(
     trial_dir: str | os.PathLike,
-    config: dict,
+    identity: dict,
     first: tuple[A, R] | None,
     build: Build[A, R],
 ) -> tuple[A, R, dict, str | None]:
@@ -111,7 +111,7 @@ def restore_newest(
         else:
             agent, room = build()
         try:
-            meta = restore_checkpoint(trial_dir, agent, room, name, config=config)
+            meta = restore_checkpoint(trial_dir, agent, room, name, identity=identity)
         except storage.CorruptFileError as exc:
             problems.append(" ".join(str(exc).split()))
             continue

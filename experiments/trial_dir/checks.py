@@ -19,7 +19,7 @@ import re
 from pathlib import Path
 
 from experiments.trial_dir import manifest, storage
-from experiments.trial_dir.config_file import identity_text, trial_identity
+from experiments.trial_dir.config_file import identity_text
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     BACKEND_FILE,
@@ -110,12 +110,13 @@ def chunk_paths(trial_dir: str | os.PathLike, kind: str) -> dict[int, Path]:
     return dict(sorted(chunks.items()))
 
 
-def check_files(trial_dir: Path, meta: dict, config: dict) -> manifest.Manifest | None:
+def check_files(trial_dir: Path, meta: dict, identity: dict) -> manifest.Manifest | None:
     """TrialError unless the logs and backend.json of the trial whose checkpoint has metadata
     `meta` are whole and as its manifest recorded them (the memory segments are checked when the
-    checkpoint is restored); the manifest, None for a trial from before manifests."""
+    checkpoint is restored), those of the trial of `identity` (config_file.trial_identity); the
+    manifest, None for a trial from before manifests."""
     recorded = recorded_manifest(trial_dir, meta)
-    check_logs(trial_dir, int(meta["iteration"]), config, recorded)
+    check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
     if recorded is not None:
         _check_backend(trial_dir, recorded)
     return recorded
@@ -151,11 +152,11 @@ def checked_chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
 def check_logs(
     trial_dir: str | os.PathLike,
     iteration: int,
-    config: dict,
+    identity: dict,
     recorded: manifest.Manifest | None = None,
 ) -> None:
     """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
-    is missing, unreadable, of another trial than `config`'s (its config.json, settings added),
+    is missing, unreadable, of another trial than `identity` (config_file.trial_identity),
     not as the checkpoint's manifest (`recorded`, None for a trial from before manifests)
     recorded it, not recorded there, or holds other rows than its name and period say: the
     iterations chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
@@ -163,7 +164,7 @@ def check_logs(
     work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of both
     layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
     trial_dir = Path(trial_dir)
-    own = trial_identity(config)
+    own = identity
     found = {
         kind: {s: p for s, p in checked_chunks(trial_dir, kind).items() if s < iteration}
         for kind in LOG_KINDS

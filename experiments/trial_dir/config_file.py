@@ -1,6 +1,7 @@
 """config.json across versions, and the identity of the trial it makes: settings added after
 trials were written, and what a trial's checkpoints, log chunks, memory segments and evaluations
-carry of it (`trial_identity`), so that a file of another trial is told apart.
+carry of it (`trial_identity`), so that a file of another trial is told apart; what every log
+row carries of it (`source_of`), and where two configs differ (`config_differences`).
 
 A trial's config.json holds every setting it ran with. A setting added later (the vocal tract,
 `voice`) is absent from older trials, which ran with the value the setting declares beside its
@@ -23,7 +24,11 @@ import copy
 import dataclasses
 import hashlib
 import json
+import os
+from pathlib import Path
+from typing import Any
 
+from experiments.trial_dir.log_schema import SOURCE_COLUMNS
 from sim.config import BEFORE, WorldConfig
 from sim.vocal.config import VoiceConfig
 
@@ -127,3 +132,24 @@ def identity_text(identity: object) -> str:
     """An identity as messages show it: "seed 5, config 0123456789ab"."""
     found = identity if isinstance(identity, dict) else {}
     return f"seed {found.get('seed', '?')}, config {found.get('config', '?')}"
+
+
+def config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, Any, Any]]:
+    """(dotted key, value in a, value in b) of every setting where two nested configs differ."""
+    out = []
+    for k in sorted(set(a) | set(b)):
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += config_differences(va, vb, f"{prefix}{k}.")
+        elif va != vb:
+            out.append((f"{prefix}{k}", va, vb))
+    return out
+
+
+def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
+    """The source columns of a trial's rows (log_schema.SOURCE_COLUMNS), from its directory
+    and config (of any version: a trial older than the voice setting ran with VocalTractLab)."""
+    trial = with_added_settings(config)["trial"]
+    name = Path(trial_dir).resolve().name
+    values = (name, int(trial["seed"]), str(trial["grasp"]), str(trial["voice"]))
+    return dict(zip(SOURCE_COLUMNS, values, strict=True))

@@ -56,9 +56,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.log_schema import SOURCE_COLUMNS
-
 # The trial itself -----------------------------------------------------------------------
 CONFIG_FILE = "config.json"
 CHECKPOINT_FILE = "checkpoint.npz"
@@ -164,15 +161,6 @@ of the whole folder before it mixes them). Every row names its trial, seed, back
 With the project installed: `from experiments.analysis.logs import read_log, read_batch_logs`;
 the columns are described in experiments/trial_dir/log_schema.py.
 """
-
-
-def source_of(trial_dir: str | os.PathLike, config: dict) -> dict[str, str | int]:
-    """The source columns of a trial's rows (log_schema.SOURCE_COLUMNS), from its directory
-    and config (of any version: a trial older than the voice setting ran with VocalTractLab)."""
-    trial = with_added_settings(config)["trial"]
-    name = Path(trial_dir).resolve().name
-    values = (name, int(trial["seed"]), str(trial["grasp"]), str(trial["voice"]))
-    return dict(zip(SOURCE_COLUMNS, values, strict=True))
 
 
 # The key of a chunk's table attrs that holds its trial's identity, and where pandas keeps a

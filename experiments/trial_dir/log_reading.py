@@ -16,16 +16,11 @@ from experiments.trial_dir.checks import check_chunk, chunk_identity, chunk_path
 from experiments.trial_dir.config_file import (
     UnknownSettingError,
     check_known,
+    source_of,
     trial_identity,
     with_added_settings,
 )
-from experiments.trial_dir.layout import (
-    CONFIG_FILE,
-    LOST_CHUNK_REMEDY,
-    check_kind,
-    kind_folder,
-    source_of,
-)
+from experiments.trial_dir.layout import CONFIG_FILE, LOST_CHUNK_REMEDY, check_kind, kind_folder
 from experiments.trial_dir.log_schema import SOURCE_COLUMNS, upgraded
 
 

@@ -23,15 +23,15 @@ import numpy as np
 
 from experiments.trial_dir import storage
 from experiments.trial_dir.checks import old_chunks
-from experiments.trial_dir.layout import chunk_file, source_of
+from experiments.trial_dir.layout import chunk_file
 from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 
 
-def move_old_chunks(trial_dir: Path, config: dict) -> int:
-    """Bring the chunks of the old layout into their kinds' folders (module docstring);
-    returns how many were moved. Called under the directory's lock, after the logs were
-    checked (a chunk found in both layouts stops that check)."""
-    source = source_of(trial_dir, config)
+def move_old_chunks(trial_dir: Path, source: dict) -> int:
+    """Bring the chunks of the old layout into their kinds' folders (module docstring), the source
+    columns their rows lack set to `source` (config_file.source_of); returns how many were
+    moved. Called under the directory's lock, after the logs were checked (a chunk found in both
+    layouts stops that check)."""
     moved = 0
     for kind, start, path in old_chunks(trial_dir):
         target = Path(trial_dir) / chunk_file(kind, start)

@@ -29,6 +29,8 @@ from experiments.trial_dir.config_file import (
     EXTENSIBLE,
     UnknownSettingError,
     check_known,
+    config_differences,
+    source_of,
     trial_identity,
     with_added_settings,
 )
@@ -41,7 +43,6 @@ from experiments.trial_dir.layout import (
     LOG_README_FILE,
     STALE_PREFIX,
     TRIAL_ENTRIES,
-    source_of,
 )
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from experiments.trial_dir.resume import prepare_resume
@@ -141,7 +142,7 @@ def _opened(
         _write_first_config(d, config)
     identity, source = trial_identity(config), source_of(d, config)
     notices: list[str] = []
-    restored = prepare_resume(d, config, parts, build, notices) if resume else None
+    restored = prepare_resume(d, identity, source, parts, build, notices) if resume else None
     if restored is None:
         agent, room = parts
         unreached = np.full(words, np.inf)
@@ -199,7 +200,7 @@ def _check_same_configuration(config_path: Path, held: dict, config: dict) -> No
         raise TrialError(str(exc)) from None
     diff = [
         f"{key}: {a!r} != {b!r}"
-        for key, a, b in storage.config_differences(held, config)
+        for key, a, b in config_differences(held, config)
         if key not in EXTENSIBLE
     ]
     if diff:

@@ -30,7 +30,12 @@ import pandas as pd
 
 from experiments.trial_dir import backend_record, checkpoint, manifest, storage
 from experiments.trial_dir.checks import check_files
-from experiments.trial_dir.config_file import UnknownSettingError, check_known, with_added_settings
+from experiments.trial_dir.config_file import (
+    UnknownSettingError,
+    check_known,
+    trial_identity,
+    with_added_settings,
+)
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.eval_worlds import OWN, own_world
 from experiments.trial_dir.evaluation import Evaluation, in_world
@@ -148,7 +153,7 @@ class TrialReading:
 
     def check_checkpoint_identity(self, meta: dict, config: dict) -> None:
         """TrialError if the newest checkpoint (of metadata `meta`) is another trial's."""
-        checkpoint.check_identity(self.dir / CHECKPOINT_FILE, meta, config)
+        checkpoint.check_identity(self.dir / CHECKPOINT_FILE, meta, trial_identity(config))
 
     def records_manifest(self) -> bool:
         """Whether it records a manifest of its files (manifest.py), which every version since
@@ -158,7 +163,7 @@ class TrialReading:
     def check_files(self, meta: dict, config: dict) -> manifest.Manifest | None:
         """TrialError unless the logs and backend.json a checkpoint of metadata `meta` covers
         are whole and as recorded (checks.check_files); the manifest, None before manifests."""
-        return check_files(self.dir, meta, config)
+        return check_files(self.dir, meta, trial_identity(config))
 
     def restored(
         self, parts_of: Callable[[dict], tuple[checkpoint.A, checkpoint.R]]
@@ -176,8 +181,9 @@ class TrialReading:
             config = self.checked_config()
         except UnknownSettingError as exc:
             raise TrialError(str(exc)) from None
+        identity = trial_identity(config)
         agent, room, meta, fallback = checkpoint.restore_newest(
-            self.dir, config, None, lambda: parts_of(config)
+            self.dir, identity, None, lambda: parts_of(config)
         )
         if fallback is not None:
             # Only the resume may fall back: it rewrites the logs past the previous checkpoint.
@@ -187,7 +193,7 @@ class TrialReading:
             )
         if meta["iteration"] == 0:
             raise TrialError(f"{self.dir} has not reached its first checkpoint yet")
-        if check_files(self.dir, meta, config) is None:
+        if check_files(self.dir, meta, identity) is None:
             manifest.warn_unchecked(self.dir)
         return config, agent, room, meta
 

@@ -24,18 +24,24 @@ from experiments.trial_dir.storage import remove_litter
 
 
 def prepare_resume(
-    trial_dir: Path, config: dict, parts: tuple[A, R], build: Build[A, R], notices: list[str]
+    trial_dir: Path,
+    identity: dict,
+    source: dict,
+    parts: tuple[A, R],
+    build: Build[A, R],
+    notices: list[str],
 ) -> tuple[A, R, dict, manifest.Manifest | None] | None:
     """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
-    checkpoint from before manifests) of the newest usable checkpoint, restored into `parts`
-    (fresh ones `build` builds where a restore fails half-way),
-    whose logs are whole and as recorded, or None to start from iteration 0 (no checkpoint and
-    no logs yet). Everything is checked before anything is changed; then a damaged newest
-    checkpoint is kept as checkpoint.damaged.npz, the litter of killed writers removed, old
-    logs moved into their folders and the work past the checkpoint (log chunks, memory
-    segments, manifest files) dropped: the run writes it again. Appends to `notices` one line
-    per thing done or noticed. TrialError if the trial cannot be resumed (the message says why
-    and what can be done)."""
+    checkpoint from before manifests) of the newest usable checkpoint of the trial of `identity`
+    (config_file.trial_identity), restored into `parts` (fresh ones `build` builds where a
+    restore fails half-way), whose logs are whole and as recorded, or None to start from
+    iteration 0 (no checkpoint and no logs yet). Everything is checked before anything is
+    changed; then a damaged newest checkpoint is kept as checkpoint.damaged.npz, the litter of
+    killed writers removed, old logs moved into their folders (their rows given the trial's
+    `source` columns, config_file.source_of) and the work past the checkpoint (log chunks,
+    memory segments, manifest files) dropped: the run writes it again. Appends to `notices` one
+    line per thing done or noticed. TrialError if the trial cannot be resumed (the message says
+    why and what can be done)."""
     newest = trial_dir / CHECKPOINT_FILE
     if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
         # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
@@ -51,9 +57,9 @@ def prepare_resume(
         notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
         restored = None
     else:
-        agent, room, meta, fallback = restore_newest(trial_dir, config, parts, build)
+        agent, room, meta, fallback = restore_newest(trial_dir, identity, parts, build)
         recorded = recorded_manifest(trial_dir, meta)
-        check_logs(trial_dir, int(meta["iteration"]), config, recorded)
+        check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
         restored = agent, room, meta, recorded
         if "identity" not in meta:
             notices.append(
@@ -74,7 +80,7 @@ def prepare_resume(
         notices.append(
             f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
         )
-    moved = move_old_chunks(trial_dir, config)
+    moved = move_old_chunks(trial_dir, source)
     if moved:
         notices.append(
             f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "

@@ -319,18 +319,6 @@ def read_column(path: Path, name: str, data: bytes | None = None) -> list:
     return table.column(name).to_pylist()
 
 
-def config_differences(a: dict, b: dict, prefix: str = "") -> list[tuple[str, Any, Any]]:
-    """(dotted key, value in a, value in b) of every setting where two nested configs differ."""
-    out = []
-    for k in sorted(set(a) | set(b)):
-        va, vb = a.get(k), b.get(k)
-        if isinstance(va, dict) and isinstance(vb, dict):
-            out += config_differences(va, vb, f"{prefix}{k}.")
-        elif va != vb:
-            out.append((f"{prefix}{k}", va, vb))
-    return out
-
-
 def _alive(pid: int) -> bool:
     """Whether a process `pid` runs on this machine."""
     try:

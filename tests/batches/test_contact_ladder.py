@@ -10,7 +10,7 @@ from pathlib import Path
 
 from experiments.batches.spec import BatchSpec, load_spec
 from experiments.run.trial_config import full_config
-from experiments.trial_dir.storage import config_differences
+from experiments.trial_dir.config_file import config_differences
 from sim.config import ACTS_ON, WorldConfig
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -9,7 +9,7 @@ from pathlib import Path
 from test_contact_ladder import _acts_on, _config, _rungs
 
 from experiments.batches.spec import BatchSpec, load_spec
-from experiments.trial_dir.storage import config_differences
+from experiments.trial_dir.config_file import config_differences
 
 BATCHES = Path(__file__).resolve().parents[2] / "experiments" / "batches"
 

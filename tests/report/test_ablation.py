@@ -25,7 +25,7 @@ from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.report.ablations import ablation_rows, write_ablations
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
-from experiments.trial_dir.storage import config_differences
+from experiments.trial_dir.config_file import config_differences
 
 COMMANDS = 20  # random commands per ring behind the study's measure: enough to compute it
 

@@ -21,6 +21,7 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.trial_dir import storage
 from experiments.trial_dir.checks import DuplicateChunkError, check_logs
+from experiments.trial_dir.config_file import source_of, trial_identity
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import LOG_DIR, LOG_README_FILE
 from experiments.trial_dir.log_schema import (
@@ -213,7 +214,7 @@ def test_an_old_layout_trial_is_read_checked_and_evaluated(old_trial):
     expected[list(LEARNER_COLUMNS)] = np.float32("nan")
     pd.testing.assert_frame_equal(logs_of(old), expected)
     pd.testing.assert_frame_equal(logs_of(old, "words"), logs_of(new, "words"))
-    check_logs(old, 120, open_for_reading(old).config())
+    check_logs(old, 120, trial_identity(open_for_reading(old).config()))
     evaluate_trial(old, EvaluationSettings(n_placements=1))
     assert is_complete(old)
     batch = old.parent.parent / "batch"  # reported as a batch's trial
@@ -255,10 +256,10 @@ def test_a_resume_killed_mid_move_is_finished_by_the_next(old_trial):
     table = storage.read_table(first)
     table.insert(0, "trial", "trial")
     storage.write_table(first, table)
-    check_logs(old, 120, open_for_reading(old).config())
-    assert move_old_chunks(old, config) == 4
+    check_logs(old, 120, trial_identity(open_for_reading(old).config()))
+    assert move_old_chunks(old, source_of(old, config)) == 4
     assert not list((old / LOG_DIR).glob("*.parquet"))
-    check_logs(old, 120, open_for_reading(old).config())
+    check_logs(old, 120, trial_identity(open_for_reading(old).config()))
     assert read_log(old)["trial"].eq("trial").all()
 
 
@@ -270,7 +271,7 @@ def test_a_chunk_in_both_layouts_is_named_and_nothing_is_changed(trial, tmp_path
         out / LOG_DIR / "iterations-00000040.parquet",
     )
     with pytest.raises(TrialError, match="both hold the iterations from iteration 40"):
-        check_logs(out, 120, open_for_reading(out).config())
+        check_logs(out, 120, trial_identity(open_for_reading(out).config()))
     with pytest.raises(DuplicateChunkError):
         read_log(out)
     with pytest.raises(TrialError, match="both hold"):
