@@ -29,7 +29,7 @@ from experiments.run.trial_config import typed_config
 from experiments.run.trial_parts import learner_values, log_row, trial_parts
 from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, WORDS_LOG_PERIOD
 from experiments.trial_dir.opening import OpenedTrial
-from experiments.trial_dir.writing import open_for_writing
+from experiments.trial_dir.writing import Declared, open_for_writing
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom
@@ -61,18 +61,18 @@ class Trial:
         parts = build()
         words = len(parts[1].vocal_tract.config.words)
         fits = functools.partial(estimate.check_fits, settings=settings, resume=resume)
+        backend = parts[1].backend
+        declared = Declared(
+            parts[1].vocal_tract.data_record(),  # with the machine, provenance.json
+            backend.name,  # and what it declares, backend.json: both of the config
+            backend.reach(),
+            backend.capabilities(),
+        )
         # Held from here: `close` gives it up.
-        self.writer = open_for_writing(out_dir, self.config, parts, build, resume, words, fits)
-        try:
-            self._take(self.writer.opened)
-            if not self.finished:  # who computes from here on (provenance.json)
-                self.notices += self.writer.record_start(
-                    self.iteration, self.room.vocal_tract.data_record()
-                )
-            self._record_backend()
-        except BaseException:
-            self.close()
-            raise
+        self.writer = open_for_writing(
+            out_dir, self.config, parts, build, resume, words, fits, declared
+        )
+        self._take(self.writer.opened)
 
     def _take(self, opened: OpenedTrial[Agent, Playroom]) -> None:
         """Where the run starts: what the opening returned."""
@@ -87,21 +87,13 @@ class Trial:
         """Give up the directory's lock."""
         self.writer.close()
 
-    def _record_backend(self) -> None:
-        """What the trial's backend declares, for analysis to read (backend.json)."""
-        backend = self.room.backend
-        notice = self.writer.record_backend(
-            backend.name, backend.reach(), backend.capabilities(), self.finished
-        )
-        if notice is not None:
-            self.notices.append(notice)
-
     @property
     def finished(self) -> bool:
         return self.iteration >= self.settings.iterations
 
     # Checkpoints --------------------------------------------------------------------------
-    def _save_checkpoint(self) -> None:
+    def _save_checkpoint(self, logs: dict | None = None) -> None:
+        """The checkpoint at the iteration reached, with the period's `logs` (`_logs`)."""
         self.writer.save_checkpoint(
             self.agent,
             self.room,
@@ -109,6 +101,7 @@ class Trial:
             self.finished,
             self.counts,
             self.best_word_distance,
+            logs,
         )
 
     # The loop -----------------------------------------------------------------------------
@@ -141,7 +134,6 @@ class Trial:
             self._save_checkpoint()
         rows: list[tuple[dict, np.ndarray]] = []
         word_rows: list[dict] = []
-        chunk_start = self.iteration
         while self.iteration < total:
             stop_requests.raise_if_requested()  # one dropped in a finalizer (see there)
             started = progress_bar.clock()
@@ -156,9 +148,8 @@ class Trial:
             if report is not None and self.iteration % every == 0:
                 report(self.iteration)
             if self.iteration % self.settings.checkpoint_every == 0 or self.iteration == total:
-                self._write_logs(chunk_start, rows, word_rows)
-                self._save_checkpoint()
-                rows, word_rows, chunk_start = [], [], self.iteration
+                self._save_checkpoint(self._logs(rows, word_rows))
+                rows, word_rows = [], []
 
     def _iterate(self) -> tuple[dict, np.ndarray]:
         """One iteration: its row of events (`log_row`) and its learner's values."""
@@ -182,16 +173,16 @@ class Trial:
             row[word] = float(best)
         return row
 
-    def _write_logs(
-        self, start: int, rows: list[tuple[dict, np.ndarray]], word_rows: list[dict]
-    ) -> None:
+    @staticmethod
+    def _logs(rows: list[tuple[dict, np.ndarray]], word_rows: list[dict]) -> dict:
+        """A period's logs, as the writer takes them: kind -> (rows, columns written plain)."""
         events = pd.DataFrame([row for row, _ in rows])
         values = np.vstack([v for _, v in rows]).astype(LEARNER_DTYPE)
         learner = pd.DataFrame(values, columns=list(LEARNER_COLUMNS))
-        iterations = pd.concat([events, learner], axis=1)
-        self.writer.write_chunk("iterations", start, iterations, plain=LEARNER_COLUMNS)
+        logs = {"iterations": (pd.concat([events, learner], axis=1), LEARNER_COLUMNS)}
         if word_rows:
-            self.writer.write_chunk("words", start, pd.DataFrame(word_rows))
+            logs["words"] = (pd.DataFrame(word_rows), ())
+        return logs
 
 
 def run_trial(

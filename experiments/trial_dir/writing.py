@@ -3,9 +3,10 @@ what a writer does to a trial directory, decided and recorded here, so that it n
 
 - `open_for_writing(...)`: a trial's run, started or resumed: the opening's decision
   (opening.py: the directory checked, locked, config.json written or compared, a resume's
-  checkpoint restored, an extension), then its recorded writes (`TrialWriter`): log chunks,
-  memory segments, each checkpoint with the manifest of what was written since the one before
-  it, backend.json and provenance.json.
+  checkpoint restored, an extension), what the run declares of itself recorded
+  (provenance.json, backend.json), then its recorded writes (`TrialWriter`): each checkpoint
+  period's log chunks and memory segment, the manifest of what was written since the
+  checkpoint before, and the checkpoint.
 - `open_for_evaluation(trial_dir)`: the trial's derived files, under its lock
   (`EvaluationWriter`): the trial restored and checked whole, a killed writer's litter removed,
   its evaluation in a world written as one unit, eval.json last; and the batch task's timing
@@ -19,7 +20,7 @@ the agent and room are the caller's, of which only what is written is asked for.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Generic, Protocol
@@ -61,6 +62,18 @@ class RoomState(Protocol):
     def get_state(self) -> dict: ...
 
 
+@dataclass(frozen=True)
+class Declared:
+    """What a run declares of itself before it computes: the inputs it computes with, beside the
+    machine and code (provenance.json: provenance_file.record_start), and what its grasp
+    backend declares (backend.json: backend_record.write_once)."""
+
+    inputs: dict[str, str] | None
+    grasp: str
+    reach: float
+    capabilities: dict[str, bool]
+
+
 class TrialWriter(Generic[A, R]):
     """A trial directory opened for its run (`open_for_writing`), locked until `close`: what the
     run starts from (`opened`), and the writes it records."""
@@ -68,6 +81,8 @@ class TrialWriter(Generic[A, R]):
     def __init__(self, opened: OpenedTrial[A, R]) -> None:
         self.opened = opened
         self.dir = opened.dir
+        # Where the checkpoint period being computed starts: its chunks are named by it.
+        self._period_start = opened.iteration
         # What the memory's segments hold (each checkpoint holds the rest), the newest manifest
         # file, the manifest of the checkpoint restored, the data files written since it.
         self._memory = opened.memory
@@ -82,32 +97,35 @@ class TrialWriter(Generic[A, R]):
     def has_checkpoint(self) -> bool:
         return (self.dir / CHECKPOINT_FILE).exists()
 
-    def record_start(self, iteration: int, inputs: dict[str, str] | None) -> list[str]:
-        """Who computes from `iteration` on, appended to provenance.json
-        (provenance_file.record_start); the lines to tell the user."""
-        return record_start(self.dir, iteration, inputs)
-
-    def record_backend(
-        self, grasp: str, reach: float, capabilities: dict[str, bool], finished: bool
-    ) -> str | None:
-        """What the trial's backend declares, for analysis to read (backend.json): written
-        once, or rewritten when lost or damaged if the backend declares what the trial recorded
-        (backend_record.write_once); a line to tell the user, or None. A finished trial from
-        before backend.json is left without one: readers compute it from its config."""
+    def _record_declared(self, declared: Declared, finished: bool) -> None:
+        """What the run declares, recorded before it computes, the lines to tell the user
+        added to the opening's notices: who computes from here on (provenance.json), unless
+        the trial is `finished`; what its backend declares, for analysis to read
+        (backend.json), written once, or rewritten when lost or damaged if the backend declares
+        what the trial recorded (backend_record.write_once). A finished trial from before
+        backend.json is left without one: readers compute it from its config."""
+        notices = self.opened.notices
+        if not finished:
+            notices += record_start(self.dir, self.opened.iteration, declared.inputs)
         if finished and not (self.dir / BACKEND_FILE).exists() and self._recorded is None:
-            return None
-        return backend_record.write_once(
-            self.dir, grasp, reach, capabilities, self._recorded, self._unrecorded
+            return
+        notice = backend_record.write_once(
+            self.dir,
+            declared.grasp,
+            declared.reach,
+            declared.capabilities,
+            self._recorded,
+            self._unrecorded,
         )
+        if notice is not None:
+            notices.append(notice)
 
-    def write_chunk(
-        self, kind: str, start: int, table: pd.DataFrame, plain: tuple[str, ...] = ()
-    ) -> None:
-        """One chunk of a log, in its kind's folder, its source columns first, carrying the
-        trial's identity; recorded by the next checkpoint's manifest."""
+    def _write_chunk(self, kind: str, table: pd.DataFrame, plain: tuple[str, ...]) -> None:
+        """One chunk of a log, of the period being closed, in its kind's folder, its source
+        columns first, carrying the trial's identity; recorded by the period's manifest."""
         for position, column in enumerate(SOURCE_COLUMNS):
             table.insert(position, column, self.opened.source[column])
-        path = self.dir / chunk_file(kind, start)
+        path = self.dir / chunk_file(kind, self._period_start)
         path.parent.mkdir(exist_ok=True)
         # Written into the Parquet schema's metadata (layout.py).
         table.attrs[CHUNK_IDENTITY_KEY] = self.opened.identity
@@ -122,11 +140,16 @@ class TrialWriter(Generic[A, R]):
         finished: bool,
         counts: dict[str, int],
         best_word_distance: np.ndarray,
+        logs: Mapping[str, tuple[pd.DataFrame, tuple[str, ...]]] | None = None,
     ) -> None:
-        """The checkpoint at `iteration`: the rows the memory stored since the last one in a
-        segment of their own, then the manifest of every file written since it, then the
-        checkpoint (the agent's state past its segments, the room's, where the run stands),
-        the one before it kept as the previous."""
+        """The checkpoint at `iteration`, closing the period since the last one, in the order
+        that survives a kill: the period's `logs` (kind -> (its rows, the columns written
+        plain)) as chunks, the rows the memory stored since the last checkpoint in a segment of
+        their own, then the manifest of every file written since it, then the checkpoint (the
+        agent's state past its segments, the room's, where the run stands), the one before it
+        kept as the previous."""
+        for kind, (table, plain) in (logs or {}).items():
+            self._write_chunk(kind, table, plain)
         memory = memory_segments.write_segment(
             self.dir, agent, self._memory, iteration, self.opened.identity
         )
@@ -162,6 +185,7 @@ class TrialWriter(Generic[A, R]):
         storage.write_arrays(newest, arrays, meta)
         self._memory = memory
         self._pointer, self._unrecorded = pointer, []
+        self._period_start = iteration
 
 
 def open_for_writing(
@@ -172,11 +196,20 @@ def open_for_writing(
     resume: bool,
     words: int,
     fits: Callable[[Path], str | None],
+    declared: Declared,
 ) -> TrialWriter[A, R]:
     """A trial directory opened for the run of the trial of `config`
-    (opening.open_trial_directory decides, and says what each argument is), locked until the
-    writer is closed. TrialError (one line) if it cannot be used."""
-    return TrialWriter(open_trial_directory(out_dir, config, parts, build, resume, words, fits))
+    (opening.open_trial_directory decides, and says what each argument but the last is), what
+    the run `declared` recorded, locked until the writer is closed. TrialError (one line) if it
+    cannot be used."""
+    opened = open_trial_directory(out_dir, config, parts, build, resume, words, fits)
+    writer = TrialWriter(opened)
+    try:
+        writer._record_declared(declared, opened.iteration >= config["trial"]["iterations"])
+    except BaseException:
+        writer.close()
+        raise
+    return writer
 
 
 @dataclass
