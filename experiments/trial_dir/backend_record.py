@@ -28,7 +28,7 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from experiments.trial_dir import manifest, storage
+from experiments.trial_dir import manifest, records
 from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.layout import BACKEND_FILE
 from models import playroom_xml
@@ -55,48 +55,30 @@ def write_once(
     recorded: manifest.Manifest | None,
     unrecorded: list[Path],
 ) -> str | None:
-    """Write a trial's record (`make_record`'s) unless it has one: the first run (or, for a
-    trial written before records, the first resume) records what its backend declares, and
-    appends its path to `unrecorded` (the files the next checkpoint's manifest records). One
-    the trial's manifest (`recorded`) holds but that is lost or damaged is written again when
-    the backend still declares exactly what was recorded (a line saying so is returned), and
-    refused otherwise (manifest.DamagedFileError, one line)."""
+    """Write a trial's record (`make_record`'s) unless it has one, or regenerate it when lost
+    or damaged if the backend declares exactly what was recorded (records.regenerate): the
+    first run (or, for a trial written before records, the first resume) records what its
+    backend declares. A line to tell the user, or None; manifest.DamagedFileError if it
+    cannot be regenerated."""
     record = make_record(grasp, reach, capabilities)
-    path = Path(trial_dir) / BACKEND_FILE
-    if recorded is None or path not in recorded:
-        if not path.exists():
-            storage.write_json(path, record)
-        unrecorded.append(path)
-        return None
-    try:
-        recorded.read_bytes(path, "")
-        return None
-    except manifest.DamagedFileError as exc:
-        problem = str(exc).split(":")[0]
-    data = storage.json_bytes(record)
-    if manifest.entry_of(data) != recorded.files[manifest.relative(recorded.trial_dir, path)]:
-        raise manifest.DamagedFileError(
-            f"{problem}, and the backend now declares another record than the trial wrote "
-            f"({record}): it cannot be regenerated; restore it from a backup"
-        )
-    storage.write_bytes(path, data)
-    return f"{problem}: regenerated from the backend's declaration, identical to the recorded one"
+    return records.regenerate(
+        trial_dir, "backend", record, recorded, unrecorded, "the backend's declaration"
+    )
 
 
 def read_record(trial_dir: str | os.PathLike, config: dict) -> dict:
-    """A trial's record: its backend.json, checked against the trial's manifest, or for a
-    trial written before it, `recorded_before` of its config.json. ValueError (one line) for a
-    record without FIELDS; storage.CorruptFileError for a backend.json that is not JSON or not
-    what the trial recorded (manifest.DamagedFileError, saying how to regenerate it)."""
-    path = Path(trial_dir) / BACKEND_FILE
-    recorded = manifest.trial_manifest(trial_dir, warn=False)
-    if recorded is not None and path in recorded:
-        remedy = f"`playroom run --out {trial_dir} --resume` regenerates it"
-        record = storage.json_from_bytes(recorded.read_bytes(path, remedy), path)
-    else:
-        record = storage.read_json(path) if path.exists() else recorded_before(config)
+    """A trial's record: its backend.json, checked against the trial's manifest
+    (records.read_checked), or for a trial written before it, `recorded_before` of its
+    config.json. ValueError (one line) for a record without FIELDS; storage.CorruptFileError
+    for a backend.json that is not JSON or not what the trial recorded
+    (manifest.DamagedFileError, saying how to regenerate it)."""
+    record = records.read_checked(trial_dir, "backend")
+    if record is None:
+        record = recorded_before(config)
     if not isinstance(record, dict) or set(FIELDS) - set(record):
-        raise ValueError(f"{path} lacks the backend's {', '.join(FIELDS)}")
+        raise ValueError(
+            f"{records.record_path(trial_dir, 'backend')} lacks the backend's {', '.join(FIELDS)}"
+        )
     return record
 
 

@@ -18,11 +18,10 @@ import os
 import re
 from pathlib import Path
 
-from experiments.trial_dir import manifest, storage
+from experiments.trial_dir import manifest, records, storage
 from experiments.trial_dir.config_file import identity_text
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
-    BACKEND_FILE,
     CHUNK_IDENTITY_KEY,
     LOG_CHUNK_PREFIX,
     LOG_DIR,
@@ -118,7 +117,7 @@ def check_files(trial_dir: Path, meta: dict, identity: dict) -> manifest.Manifes
     recorded = recorded_manifest(trial_dir, meta)
     check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
     if recorded is not None:
-        _check_backend(trial_dir, recorded)
+        _check_records(trial_dir, recorded)
     return recorded
 
 
@@ -130,14 +129,12 @@ def recorded_manifest(trial_dir: Path, meta: dict) -> manifest.Manifest | None:
         raise TrialError(_first_line(exc)) from None
 
 
-def _check_backend(trial_dir: Path, recorded: manifest.Manifest) -> None:
-    """TrialError unless backend.json is as the trial recorded it (when it recorded one)."""
-    path = trial_dir / BACKEND_FILE
-    if path in recorded:
-        try:
-            recorded.read_bytes(path, f"`playroom run --out {trial_dir} --resume` regenerates it")
-        except storage.CorruptFileError as exc:
-            raise TrialError(str(exc)) from None
+def _check_records(trial_dir: Path, recorded: manifest.Manifest) -> None:
+    """TrialError unless every record the trial recorded is as recorded (records.py)."""
+    try:
+        records.check_recorded(trial_dir, recorded)
+    except storage.CorruptFileError as exc:
+        raise TrialError(str(exc)) from None
 
 
 def checked_chunks(trial_dir: Path, kind: str) -> dict[int, Path]:

@@ -4,7 +4,8 @@ good one before it computes anything from it.
 
 What is recorded. Every data file of a trial directory but its checkpoints: the log chunks of
 both kinds (`log/iterations/chunk-*.parquet`, `log/words/chunk-*.parquet`), the memory
-segments (`memory/rows-*.npz`) and `backend.json`. Checkpoints are not listed: an `.npz` is a
+segments (`memory/rows-*.npz`) and the trial's records (`backend.json`, `summary.json`:
+layout.RECORDS, records.py). Checkpoints are not listed: an `.npz` is a
 zip archive whose every member carries its own CRC-32, which NumPy's reader checks, and the
 previous checkpoint is kept beside the newest. config.json is not listed either: a resume
 rewrites it when the trial is extended, and its content is checked otherwise (each
@@ -42,7 +43,6 @@ from pathlib import Path
 
 from experiments.trial_dir import storage
 from experiments.trial_dir.layout import (
-    BACKEND_FILE,
     CHECKPOINT_FILE,
     LOG_DIR,
     LOG_KINDS,
@@ -50,6 +50,7 @@ from experiments.trial_dir.layout import (
     MEMORY_DIR,
     OLD_LOG_CHUNK_PATTERN,
     PREVIOUS_CHECKPOINT_FILE,
+    RECORDS,
     manifest_name,
 )
 
@@ -109,7 +110,7 @@ def data_files(trial_dir: str | os.PathLike) -> list[Path]:
     """Every data file of a trial directory a manifest records (module docstring), in order:
     what lies there now, recorded or not."""
     trial_dir = Path(trial_dir)
-    found = [trial_dir / BACKEND_FILE] if (trial_dir / BACKEND_FILE).is_file() else []
+    found = [trial_dir / name for name in RECORDS.values() if (trial_dir / name).is_file()]
     for kind in LOG_KINDS:
         found += sorted((trial_dir / LOG_DIR / kind).glob("chunk-*.parquet"))
     # Chunks of the old layout, side by side in log/ (a resume moves them into the folders).
@@ -228,7 +229,7 @@ def trial_manifest(trial_dir: str | os.PathLike, warn: bool = True) -> Manifest 
                 "restore them from a backup, or run the trial again from scratch into a new "
                 "directory"
             )
-        if [p for p in data_files(trial_dir) if p.name != BACKEND_FILE]:
+        if [p for p in data_files(trial_dir) if p.name not in RECORDS.values()]:
             if warn:  # files of a trial from before manifests, whose checkpoints are gone
                 warn_unchecked(trial_dir)
             return None

@@ -11,7 +11,8 @@ returns, part by part, each part checked as it is read and read once:
 - `checkpoint_meta()`, `checkpoint_arrays()`, `restored(parts_of)`: its newest checkpoint, its
   metadata, its arrays with the memory segments it names, or restored into an agent and room
   the caller builds, the trial checked whole first (checkpoint.py, checks.py);
-- `backend()`, `computed_on()`, `timing()`: backend.json, provenance.json, timing.json.
+- `backend()`, `record(kind)`, `computed_on()`, `timing()`: backend.json, any of its records
+  (layout.RECORDS: backend.json, summary.json), provenance.json, timing.json.
 
 Opening reads nothing: a part is read when asked for, so that a reader pays only for what it
 reads (a report reads no checkpoint, an evaluation no evaluation). No simulator is loaded.
@@ -28,7 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from experiments.trial_dir import backend_record, checkpoint, manifest, storage
+from experiments.trial_dir import backend_record, checkpoint, manifest, records, storage
 from experiments.trial_dir.checks import check_files
 from experiments.trial_dir.config_file import (
     UnknownSettingError,
@@ -235,6 +236,11 @@ class TrialReading:
         """What its backend declared (backend.json, checked against the manifest; older trials:
         computed from `config`, its config.json): backend_record.read_record."""
         return backend_record.read_record(self.dir, config)
+
+    def record(self, kind: str) -> Any | None:
+        """Its record of `kind` (a key of layout.RECORDS: "backend", "summary"), checked
+        against its manifest (records.read_checked); None when it has none."""
+        return records.read_checked(self.dir, kind)
 
     def has_backend_record(self) -> bool:
         return (self.dir / BACKEND_FILE).exists()

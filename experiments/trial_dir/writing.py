@@ -28,7 +28,7 @@ from typing import Generic, Protocol
 import numpy as np
 import pandas as pd
 
-from experiments.trial_dir import backend_record, manifest, memory_segments, storage
+from experiments.trial_dir import backend_record, manifest, memory_segments, records, storage
 from experiments.trial_dir.checkpoint import A, Build, R
 from experiments.trial_dir.errors import TrialError, TrialLocked
 from experiments.trial_dir.evaluation import Evaluation, evaluation_files
@@ -100,13 +100,32 @@ class TrialWriter(Generic[A, R]):
     def _record_declared(self, declared: Declared, finished: bool) -> None:
         """What the run declares, recorded before it computes, the lines to tell the user
         added to the opening's notices: who computes from here on (provenance.json), unless
-        the trial is `finished`; what its backend declares, for analysis to read
-        (backend.json), written once, or rewritten when lost or damaged if the backend declares
-        what the trial recorded (backend_record.write_once). A finished trial from before
-        backend.json is left without one: readers compute it from its config."""
+        the trial is `finished`, else its summary regenerated if lost or damaged since
+        (records.regenerate); what its backend declares, for analysis to read (backend.json),
+        written once, or rewritten when lost or damaged if the backend declares what the trial
+        recorded (backend_record.write_once). A finished trial from before backend.json is left
+        without one: readers compute it from its config."""
         notices = self.opened.notices
         if not finished:
             notices += record_start(self.dir, self.opened.iteration, declared.inputs)
+        elif (
+            self._recorded is not None
+            and records.record_path(self.dir, "summary") in self._recorded
+        ):
+            opened = self.opened
+            summary = records.summary_record(
+                opened.iteration, opened.counts, opened.best_word_distance
+            )
+            notice = records.regenerate(
+                self.dir,
+                "summary",
+                summary,
+                self._recorded,
+                self._unrecorded,
+                "the trial's last checkpoint",
+            )
+            if notice is not None:
+                notices.append(notice)
         if finished and not (self.dir / BACKEND_FILE).exists() and self._recorded is None:
             return
         notice = backend_record.write_once(
@@ -150,6 +169,9 @@ class TrialWriter(Generic[A, R]):
         kept as the previous."""
         for kind, (table, plain) in (logs or {}).items():
             self._write_chunk(kind, table, plain)
+        if finished:  # where the run ended, for a reader without NumPy
+            summary = records.summary_record(iteration, counts, best_word_distance)
+            records.write_new(self.dir, "summary", summary, self._unrecorded)
         memory = memory_segments.write_segment(
             self.dir, agent, self._memory, iteration, self.opened.identity
         )
