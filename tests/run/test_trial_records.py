@@ -95,3 +95,13 @@ def test_a_record_kind_added_to_the_declaration_is_checked_without_another_edit(
     with pytest.raises(TrialError, match="extra.json"):
         load_trial(out)
     assert not is_complete(out)
+
+
+def test_an_extended_trial_summarises_its_new_end(finished, tmp_path):
+    out = _copy(finished, tmp_path)
+    longer = TrialSettings(iterations=TOTAL + PERIOD, seed=SEED, checkpoint_every=PERIOD)
+    run_trial(out, longer, resume=True, progress=False)
+    summary = open_for_reading(out).record("summary")
+    assert summary["iteration"] == TOTAL + PERIOD
+    assert summary["counts"] == storage.read_meta(out / layout.CHECKPOINT_FILE)["counts"]
+    load_trial(out)
