@@ -15,6 +15,7 @@ nothing here, in the checks or in the readers names one.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -111,5 +112,5 @@ def summary_record(iteration: int, counts: dict[str, int], best_word_distance: n
     return {
         "iteration": int(iteration),
         "counts": {name: int(n) for name, n in counts.items()},
-        "best_word_distance": storage.finite_or_null([float(d) for d in best_word_distance]),
+        "best_word_distance": [float(d) if math.isfinite(d) else None for d in best_word_distance],
     }
