@@ -283,10 +283,8 @@ def rows(evaluated: list[Evaluated], a: BatchResults, b: BatchResults) -> list[l
         else:
             test = ", ".join(x for x in (_method(within) if within else "", _untested_text(e)) if x)
             p = _labelled(within, outcome_p) if within else _ratio(e, groups)
-            out.append(
-                [m.label, *sides, test, p, holm_text(within), rank_cell(within)]
-                + [rank_holm_text(within)]
-            )
+            tests = [holm_text(within), rank_cell(within), rank_holm_text(within)]
+            out.append([m.label, *sides, test, p, *tests])
         out += _pooled_rows(e, groups)
     return out
 
