@@ -24,9 +24,7 @@ import pandas as pd
 
 from experiments.analysis.batch_checks import check_batch
 from experiments.analysis.finished import unfinished_trials, warn_unfinished
-from experiments.trial_dir import manifest
-from experiments.trial_dir.layout import check_kind
-from experiments.trial_dir.reading import open_for_reading, trials_in
+from experiments.trial_dir.reading import check_kind, open_for_reading, trials_in, warn_unchecked
 
 
 def read_log(
@@ -49,7 +47,7 @@ def read_log(
     UncheckedTrialWarning."""
     frame, checked = open_for_reading(trial_dir).log(kind, columns)
     if not checked:
-        manifest.warn_unchecked(trial_dir)
+        warn_unchecked(trial_dir)
     return frame
 
 
@@ -92,5 +90,5 @@ def read_batch_logs(
         unchecked += [] if checked else [d.name]
         frames += [] if frame.empty else [frame]
     if unchecked:
-        manifest.warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
+        warn_unchecked(f"{len(unchecked)} trial(s) of {batch_dir} ({unchecked[0]}, ...)")
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()

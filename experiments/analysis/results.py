@@ -29,14 +29,21 @@ from experiments.analysis.logs import read_log
 from experiments.analysis.mechanisms import LOG_COLUMNS as MECHANISM_COLUMNS
 from experiments.analysis.mechanisms import trial_mechanisms
 from experiments.trial_dir import storage
-from experiments.trial_dir.backend_record import CAPABILITIES, study_reach
 from experiments.trial_dir.config_file import with_added_settings
-from experiments.trial_dir.eval_record import SCENES_KEY
 from experiments.trial_dir.evaluation import Evaluation
 from experiments.trial_dir.log_schema import DIVERGED
-from experiments.trial_dir.manifest import UncheckedTrialWarning, warn_unchecked_once
 from experiments.trial_dir.provenance import SHORT_FIELDS
-from experiments.trial_dir.reading import TRIAL_MARKS, is_trial, open_for_reading, trials_in
+from experiments.trial_dir.reading import (
+    CAPABILITIES,
+    SCENES_KEY,
+    TRIAL_MARKS,
+    UncheckedTrialWarning,
+    is_trial,
+    open_for_reading,
+    study_reach,
+    trials_in,
+    warn_unchecked_once,
+)
 
 COMPETENCE_SCOPES = ("all", "ring1", "ring2", "ring3")
 

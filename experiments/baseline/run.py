@@ -37,8 +37,8 @@ from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.policy_actor import PolicyActor
 from experiments.measure.trial_evaluation import measured
 from experiments.run.trial_parts import fresh_trial_parts
-from experiments.trial_dir import manifest, provenance, storage
-from experiments.trial_dir.baseline_run import open_baseline_run
+from experiments.trial_dir import provenance, storage
+from experiments.trial_dir.baseline_run import file_record, open_baseline_run
 from experiments.trial_dir.evaluation import evaluation_files
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked, holds_only_lock
 from experiments.trial_dir.reading import EVALUATION_MARK
@@ -98,11 +98,9 @@ def trained_toys(out: Path) -> dict[str, Any]:
     try:
         toys = storage.read_json(path)["toys"]
         for toy, entry in toys.items():
-            size, sha256 = entry["file"]
-            recorded = manifest.Manifest(
-                out, {policy_file(int(toy)): manifest.Entry(size, sha256)}, 0
+            open_baseline_run(out).recorded_bytes(
+                policy_file(int(toy)), entry["file"], f"remove {out} to run it again"
             )
-            recorded.read_bytes(out / policy_file(int(toy)), f"remove {out} to run it again")
     except (KeyError, TypeError, ValueError) as exc:
         raise BaselineError(f"{path} is damaged ({exc}): remove {out} to run it again") from None
     except storage.CorruptFileError as exc:
@@ -150,7 +148,7 @@ def run_baseline(
                 seed = settings.toy_seed(toy)
                 data, entry = training.train_policy(env, n, seed, settings.torch_threads, bar)
                 entry["seed"] = seed
-                entry["file"] = manifest.entry_of(data).as_json()
+                entry["file"] = file_record(data)
                 entry["libraries"] = training.library_versions()
                 entry["trained_on"] = provenance.short_record(provenance.machine_record())
                 toys[str(toy)] = entry

@@ -23,8 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments.trial_dir import manifest
-from experiments.trial_dir.memory_segments import AGENT
 from experiments.trial_dir.reading import open_for_reading
 from learner.memory import TREE_ROWS, NearestNeighbourMemory
 from learner.sensorimotor_model import MODELS, ModelSpec
@@ -89,7 +87,7 @@ def manifest_figures(trial: Path, passes: int = 3) -> Iterator[tuple[str, float,
     check, every, files, size = math.inf, math.inf, 0, 0
     for _ in range(passes):
         start = time.perf_counter()
-        recorded = manifest.trial_manifest(trial)
+        recorded = open_for_reading(trial).file_manifest()
         if recorded is None:
             raise RuntimeError(f"{trial} recorded no manifest")
         recorded.check_present()
@@ -114,9 +112,9 @@ def query_figures(
     and their mean over the models that hold rows (random babbling's choice). Then how the
     query grows: each model of at least 4 x TREE_ROWS rows, on its first 2 x TREE_ROWS x 2^k
     rows, as it was when it held them."""
-    arrays, _ = open_for_reading(trial).checkpoint_arrays()
+    state = open_for_reading(trial).agent_state()
     rng = np.random.default_rng(0)
-    keys = {s.number: arrays[f"{AGENT}model{s.number}.key"] for s in MODELS}
+    keys = {s.number: state[f"model{s.number}.key"] for s in MODELS}
     held = [spec for spec in MODELS if len(keys[spec.number])]
     means = {"scan": 0.0, "trees": 0.0}
     for spec in held:

@@ -195,7 +195,6 @@ def cmd_eval(args: argparse.Namespace) -> None:
     from experiments.measure.trial_evaluation import evaluate_trial
     from experiments.trial_dir import storage
     from experiments.trial_dir.errors import TrialError
-    from experiments.trial_dir.provenance_file import computed_on_line
     from experiments.trial_dir.reading import open_for_reading
 
     try:
@@ -220,7 +219,7 @@ def cmd_eval(args: argparse.Namespace) -> None:
     if tested is not None:
         folder = open_for_reading(args.dir).evaluation_elsewhere(tested["name"]).folder
         print(f"  written into {os.path.join(args.dir, folder.name)}")
-    print(f"  {computed_on_line(args.dir)}")
+    print(f"  {open_for_reading(args.dir).computed_on_line()}")
     print(
         "  normalised competence (0% = random agent, 100% = perfect): "
         + ", ".join(f"{k} {percent(val)}" for k, val in c.items())

@@ -36,8 +36,7 @@ from experiments.measure.evaluation import (
 )
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir.errors import TrialError
-from experiments.trial_dir.eval_record import SCENES_KEY
-from experiments.trial_dir.reading import EVALUATION_MARK, open_for_reading
+from experiments.trial_dir.reading import EVALUATION_MARK, SCENES_KEY, open_for_reading
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom

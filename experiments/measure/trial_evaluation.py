@@ -31,10 +31,9 @@ from experiments.measure.study_measure import (
 from experiments.run.trial_parts import fresh_trial_parts
 from experiments.trial_dir import provenance, storage
 from experiments.trial_dir.errors import TrialError
-from experiments.trial_dir.eval_record import SCENES_KEY
 from experiments.trial_dir.eval_worlds import OWN, EvalWorldError, own_world, world_record
 from experiments.trial_dir.evaluation import Evaluation
-from experiments.trial_dir.reading import TrialReading
+from experiments.trial_dir.reading import SCENES_KEY, TrialReading
 from experiments.trial_dir.writing import open_for_evaluation
 from sim import Playroom
 

@@ -28,8 +28,7 @@ from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import typed_config
 from experiments.run.trial_parts import learner_values, log_row, trial_parts
 from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, WORDS_LOG_PERIOD
-from experiments.trial_dir.opening import OpenedTrial
-from experiments.trial_dir.writing import Declared, open_for_writing
+from experiments.trial_dir.writing import Declared, OpenedTrial, open_for_writing
 from learner.agent import Agent
 from models.layout import TOYS, block_slice
 from sim import Playroom

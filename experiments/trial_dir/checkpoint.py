@@ -81,9 +81,7 @@ def restore_checkpoint(
     except memory_segments.ForeignSegmentError as exc:
         raise TrialError(str(exc)) from None
     try:
-        prefix = memory_segments.AGENT
-        agent_state = {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
-        agent.load_state_dict(agent_state)
+        agent.load_state_dict(memory_segments.agent_part(arrays))
         room.set_state({**meta["room"], "physics": arrays["room/physics"]})
         meta["best_word_distance"] = arrays["best_word_distance"].copy()
     except (KeyError, ValueError, TypeError) as exc:

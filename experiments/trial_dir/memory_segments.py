@@ -53,6 +53,13 @@ from experiments.trial_dir.layout import MEMORY_DIR, MEMORY_SEGMENT_PREFIX, memo
 
 # A checkpoint's keys for the agent's state: AGENT + a key of Agent.state_dict.
 AGENT = "agent/"
+
+
+def agent_part(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The agent's state among a checkpoint's `arrays`, by the keys of Agent.state_dict."""
+    return {k.removeprefix(AGENT): v for k, v in arrays.items() if k.startswith(AGENT)}
+
+
 # The checkpoint metadata's entry on its memory (what `MemoryOnDisk.meta` writes).
 MEMORY_KEY = "memory"
 _PARTS = ("motor", "key")  # each model's arrays of rows, as Agent.state_dict names them

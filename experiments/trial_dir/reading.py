@@ -8,11 +8,21 @@ returns, part by part, each part checked as it is read and read once:
   by the identity it carries (log_reading.py);
 - `evaluation()`, `evaluation_in(world)`: its evaluations, eval.json and the tables it lists
   checked (evaluation.py);
-- `checkpoint_meta()`, `checkpoint_arrays()`, `restored(parts_of)`: its newest checkpoint, its
-  metadata, its arrays with the memory segments it names, or restored into an agent and room
-  the caller builds, the trial checked whole first (checkpoint.py, checks.py);
-- `backend()`, `record(kind)`, `computed_on()`, `timing()`: backend.json, any of its records
-  (layout.RECORDS: backend.json, summary.json), provenance.json, timing.json.
+- `checkpoint_meta()`, `checkpoint_arrays()`, `agent_state()`, `restored(parts_of)`: its newest
+  checkpoint, its metadata, its arrays with the memory segments it names (the agent's part of
+  them), or restored into an agent and room the caller builds, the trial checked whole first
+  (checkpoint.py, checks.py);
+- `backend()`, `record(kind)`, `computed_on()` (or its one line), `timing()`: backend.json,
+  any of its records (layout.RECORDS: backend.json, summary.json), provenance.json,
+  timing.json;
+- `file_manifest()`: what its newest checkpoint recorded of every file, for a reader that
+  checks the files itself.
+
+What readers outside the package name of a trial's records comes through here too (the names
+imported `as` themselves below): the log kinds (`check_kind`), what backend.json declares
+(`CAPABILITIES`) and the reach the study's rules are measured by (`study_reach`), eval.json's
+key for scenes kept clear of the stick (`SCENES_KEY`), the warning of a trial read unchecked
+(written before manifests) and its one line per batch.
 
 Opening reads nothing: a part is read when asked for, so that a reader pays only for what it
 reads (a report reads no checkpoint, an evaluation no evaluation). No simulator is loaded.
@@ -29,7 +39,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from experiments.trial_dir import backend_record, checkpoint, manifest, records, storage
+from experiments.trial_dir import (
+    backend_record,
+    checkpoint,
+    manifest,
+    memory_segments,
+    records,
+    storage,
+)
+from experiments.trial_dir.backend_record import CAPABILITIES as CAPABILITIES
+from experiments.trial_dir.backend_record import study_reach as study_reach
 from experiments.trial_dir.checks import check_files
 from experiments.trial_dir.config_file import (
     UnknownSettingError,
@@ -38,6 +57,7 @@ from experiments.trial_dir.config_file import (
     with_added_settings,
 )
 from experiments.trial_dir.errors import TrialError
+from experiments.trial_dir.eval_record import SCENES_KEY as SCENES_KEY
 from experiments.trial_dir.eval_worlds import OWN, own_world
 from experiments.trial_dir.evaluation import Evaluation, in_world
 from experiments.trial_dir.layout import (
@@ -55,8 +75,14 @@ from experiments.trial_dir.layout import (
     manifest_name,
     memory_segment_name,
 )
+from experiments.trial_dir.layout import check_kind as check_kind
 from experiments.trial_dir.log_reading import read_log_checked
-from experiments.trial_dir.provenance_file import computed_on
+from experiments.trial_dir.manifest import (
+    UncheckedTrialWarning as UncheckedTrialWarning,
+)
+from experiments.trial_dir.manifest import warn_unchecked as warn_unchecked
+from experiments.trial_dir.manifest import warn_unchecked_once as warn_unchecked_once
+from experiments.trial_dir.provenance_file import computed_on, computed_on_line
 
 # What marks a folder as a trial directory (layout.is_trial_dir), as messages say it.
 TRIAL_MARKS = f"{CONFIG_FILE} and {LOG_DIR}/"
@@ -151,6 +177,16 @@ class TrialReading:
         """The newest checkpoint's arrays, with every model's memory rows its segments hold,
         and its metadata (checkpoint.newest_arrays)."""
         return checkpoint.newest_arrays(self.dir)
+
+    def agent_state(self) -> dict[str, np.ndarray]:
+        """The agent's state in the newest checkpoint, every model's memory rows among it,
+        by the keys of Agent.state_dict (`checkpoint_arrays`)."""
+        return memory_segments.agent_part(self.checkpoint_arrays()[0])
+
+    def file_manifest(self) -> manifest.Manifest | None:
+        """What the newest checkpoint recorded of every file (manifest.trial_manifest: None,
+        with an UncheckedTrialWarning, for a trial from before manifests)."""
+        return manifest.trial_manifest(self.dir)
 
     def check_checkpoint_identity(self, meta: dict, config: dict) -> None:
         """TrialError if the newest checkpoint (of metadata `meta`) is another trial's."""
@@ -248,6 +284,10 @@ class TrialReading:
     def computed_on(self) -> list[dict[str, Any]]:
         """Who computed it, stretch by stretch (provenance_file.computed_on)."""
         return computed_on(self.dir)
+
+    def computed_on_line(self) -> str:
+        """Who computed it, in one line (`playroom eval` prints it)."""
+        return computed_on_line(self.dir)
 
     @property
     def timing_path(self) -> Path:

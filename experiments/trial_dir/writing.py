@@ -43,7 +43,8 @@ from experiments.trial_dir.layout import (
 )
 from experiments.trial_dir.lock import DirectoryLock, DirectoryLocked
 from experiments.trial_dir.log_schema import SOURCE_COLUMNS
-from experiments.trial_dir.opening import OpenedTrial, open_trial_directory
+from experiments.trial_dir.opening import OpenedTrial as OpenedTrial
+from experiments.trial_dir.opening import open_trial_directory
 from experiments.trial_dir.provenance_file import record_start
 from experiments.trial_dir.reading import TrialReading
 from experiments.trial_dir.storage import remove_litter
