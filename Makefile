@@ -110,7 +110,8 @@ contact-ablations: comparison-diva
 ## rung that is a contact ablation (the same batch) runs into that ablation's directory. Then
 ## `playroom ladder`: each step (its rule given the rules before it) paired by seed, with the
 ## paired t's and the signed-rank p, the cross-evaluation's split, Holm over the page's declared
-## family, a completeness check (ladder.md/.csv/.json/.png, ladder-trials.csv). Resumes
+## family, a completeness check (ladder.md/.csv/.json/.png, ladder-trials.csv, copied into
+## docs/data/). Resumes
 CONTACT_LADDER := $(basename $(notdir $(wildcard experiments/batches/contact-ladder/*.json)))
 contact-ladder: comparison-diva
 	for rung in $(CONTACT_LADDER); do \
@@ -127,12 +128,15 @@ contact-ladder: comparison-diva
 		no-push=$(OUT)/contact-ablation-no-push \
 		physical=$(OUT)/comparison-diva:physical \
 		--beside settle=$(OUT)/contact-ablation-settle --out $(OUT)/contact-ladder
+	mkdir -p docs/data
+	cp $(OUT)/contact-ladder/ladder-trials.csv docs/data/contact-ladder-trials.csv
 
 ## contact-unbundled: after `make contact-ladder`, the ladder's contact step in four rungs
 ## (experiments/batches/contact-unbundled/*.json, 32 seeds x 80000 with DIVA, both eval worlds:
 ## clear placements, the contact's reach alone, obstruction; then the ladder's contact-aligned
 ## rung, whose step is the caregiver's welded carrying), then `playroom ladder` of the whole
-## ladder with them into $(OUT)/contact-unbundled. Resumes
+## ladder with them into $(OUT)/contact-unbundled, its per-trial data copied into docs/data/.
+## Resumes
 CONTACT_UNBUNDLED := $(basename $(notdir $(wildcard experiments/batches/contact-unbundled/*.json)))
 contact-unbundled: contact-ladder
 	for rung in $(CONTACT_UNBUNDLED); do \
@@ -149,9 +153,12 @@ contact-unbundled: contact-ladder
 		no-push=$(OUT)/contact-ablation-no-push \
 		physical=$(OUT)/comparison-diva:physical \
 		--beside settle=$(OUT)/contact-ablation-settle --out $(OUT)/contact-unbundled
+	mkdir -p docs/data
+	cp $(OUT)/contact-unbundled/ladder-trials.csv docs/data/contact-unbundled-trials.csv
 
 ## held-pose-returns: the ladder's held-pose step with the stick returned at the contact limit
-## on both sides (experiments/batches/held-pose-returns/, 32 seeds), its two-rung page
+## on both sides (experiments/batches/held-pose-returns/, 32 seeds), its two-rung page, its
+## per-trial data copied into docs/data/
 held-pose-returns: $(INSTALLED)
 	for side in aligned touch; do \
 		$(BIN)/playroom batch --config experiments/batches/held-pose-returns/$$side.json \
@@ -159,11 +166,14 @@ held-pose-returns: $(INSTALLED)
 	done
 	$(BIN)/playroom ladder aligned=$(OUT)/held-pose-returns-aligned \
 		touch=$(OUT)/held-pose-returns-touch --out $(OUT)/held-pose-returns
+	mkdir -p docs/data
+	cp $(OUT)/held-pose-returns/ladder-trials.csv docs/data/held-pose-returns-trials.csv
 
 ## contact-factorial: after `make contact-ladder`, the cells the ladder lacks of three 2 x 2
 ## designs (experiments/batches/contact-factorial/*.json, 16 seeds x 80000 with DIVA), then
 ## `playroom factorial` of each: held pose x pushing, catch rule x servo arm, catch rule x the
-## contact's catch distance, into $(OUT)/contact-factorial-*. Resumes
+## contact's catch distance, into $(OUT)/contact-factorial-*, each page's per-trial data copied
+## into docs/data/. Resumes
 CONTACT_FACTORIAL := $(basename $(notdir $(wildcard experiments/batches/contact-factorial/*.json)))
 contact-factorial: contact-ladder
 	for cell in $(CONTACT_FACTORIAL); do \
@@ -185,6 +195,13 @@ contact-factorial: contact-ladder
 		held-catch-near=$(OUT)/contact-factorial-held-catch-near \
 		--factors "held-stick catch" "catch distance 0.055 m" \
 		--out $(OUT)/contact-factorial-catch-distance
+	mkdir -p docs/data
+	cp $(OUT)/contact-factorial-held-pose-pushing/factorial-trials.csv \
+		docs/data/contact-factorial-held-pose-pushing-trials.csv
+	cp $(OUT)/contact-factorial-catch-servo/factorial-trials.csv \
+		docs/data/contact-factorial-catch-servo-trials.csv
+	cp $(OUT)/contact-factorial-catch-distance/factorial-trials.csv \
+		docs/data/contact-factorial-catch-distance-trials.csv
 
 ## ablations: each departure from the study switched back alone (against the replication's
 ## seeds 0-31), and each study setting switched into the project preset alone (against the

@@ -16,6 +16,21 @@ PUBLISHED = {
     "contact-ablations": [
         ("contact-ablations", "ablations-trials.csv", "contact-ablations-trials.csv")
     ],
+    "contact-ladder": [("contact-ladder", "ladder-trials.csv", "contact-ladder-trials.csv")],
+    "contact-unbundled": [
+        ("contact-unbundled", "ladder-trials.csv", "contact-unbundled-trials.csv")
+    ],
+    "held-pose-returns": [
+        ("held-pose-returns", "ladder-trials.csv", "held-pose-returns-trials.csv")
+    ],
+    "contact-factorial": [
+        (
+            f"contact-factorial-{page}",
+            "factorial-trials.csv",
+            f"contact-factorial-{page}-trials.csv",
+        )
+        for page in ("held-pose-pushing", "catch-servo", "catch-distance")
+    ],
     "ablations": [
         ("ablations-from-study", "ablations-trials.csv", "ablations-from-study-trials.csv"),
         ("ablations-from-project", "ablations-trials.csv", "ablations-from-project-trials.csv"),
