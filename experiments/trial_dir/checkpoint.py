@@ -17,7 +17,7 @@ from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
-from experiments.trial_dir import memory_segments, storage
+from experiments.trial_dir import manifest, memory_segments, storage
 from experiments.trial_dir.config_file import identity_text
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
@@ -66,18 +66,20 @@ def restore_checkpoint(
     name: str = CHECKPOINT_FILE,
     *,
     identity: dict,
-) -> dict:
-    """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`;
-    returns the checkpoint's metadata with 'best_word_distance' added. CorruptFileError if it
-    or a segment cannot be read or restored; TrialError if either belongs to another trial
-    than the one of `identity`."""
+) -> tuple[dict, manifest.Manifest | None]:
+    """Load a trial's checkpoint, with the memory segments it names, into `agent` and `room`:
+    (the checkpoint's metadata with 'best_word_distance' added, its manifest: None before
+    manifests), the manifest's chain read once. CorruptFileError if it, its manifest or a
+    segment cannot be read or restored; TrialError if either belongs to another trial than the
+    one of `identity`."""
     path = Path(trial_dir) / name
     if not path.exists():
         raise storage.CorruptFileError(f"{path} is missing")
     arrays, meta = storage.read_arrays(path)
     check_identity(path, meta, identity)
+    recorded = memory_segments.recorded_by(path, meta)
     try:
-        arrays = memory_segments.with_rows(path, arrays, meta)
+        arrays = memory_segments.with_rows(path, arrays, meta, recorded)
     except memory_segments.ForeignSegmentError as exc:
         raise TrialError(str(exc)) from None
     try:
@@ -86,7 +88,7 @@ def restore_checkpoint(
         meta["best_word_distance"] = arrays["best_word_distance"].copy()
     except (KeyError, ValueError, TypeError) as exc:
         raise storage.CorruptFileError(f"{path} cannot be restored ({exc})") from None
-    return meta
+    return meta, recorded
 
 
 def restore_newest(
@@ -94,10 +96,11 @@ def restore_newest(
     identity: dict,
     first: tuple[A, R] | None,
     build: Build[A, R],
-) -> tuple[A, R, dict, str | None]:
+) -> tuple[A, R, dict, manifest.Manifest | None, str | None]:
     """A trial's newest usable checkpoint, restored into fresh parts (`first`, built already,
-    then `build`'s): (agent, room, meta, fallback), `fallback` None when checkpoint.npz was
-    used, else one line saying what is wrong with it (missing, or damaged). TrialError if
+    then `build`'s): (agent, room, meta, its manifest, fallback), `fallback` None when
+    checkpoint.npz was used, else one line saying what is wrong with it (missing, or damaged,
+    its manifest included). TrialError if
     neither checkpoint can be used (naming both, and what is wrong with each), or if the one
     read belongs to another trial."""
     trial_dir = Path(trial_dir)
@@ -109,11 +112,11 @@ def restore_newest(
         else:
             agent, room = build()
         try:
-            meta = restore_checkpoint(trial_dir, agent, room, name, identity=identity)
+            meta, recorded = restore_checkpoint(trial_dir, agent, room, name, identity=identity)
         except storage.CorruptFileError as exc:
             problems.append(" ".join(str(exc).split()))
             continue
-        return agent, room, meta, (problems[0] if problems else None)
+        return agent, room, meta, recorded, (problems[0] if problems else None)
     raise TrialError(
         f"{trial_dir} cannot be restored: {problems[0]}; {problems[1]}. Nothing was changed: "
         "a trial without a readable checkpoint can only be run again from scratch, into a new "

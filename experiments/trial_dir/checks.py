@@ -91,13 +91,14 @@ def old_chunks(trial_dir: str | os.PathLike) -> list[tuple[str, int, Path]]:
 def chunk_paths(trial_dir: str | os.PathLike, kind: str) -> dict[int, Path]:
     """Every chunk of one kind of log, by the iteration it starts at, in order, from both
     layouts. DuplicateChunkError (one line, naming both) for a chunk found in both."""
+    old = old_chunks(trial_dir)
     chunks: dict[int, Path] = {}
     folder = Path(trial_dir) / kind_folder(kind)
     for path in folder.glob("*.parquet"):
         match = _CHUNK.fullmatch(path.name)
         if match is not None:
             chunks[int(match["start"])] = path
-    for found_kind, start, path in old_chunks(trial_dir):
+    for found_kind, start, path in old:
         if found_kind != kind:
             continue
         if start in chunks:
@@ -109,20 +110,23 @@ def chunk_paths(trial_dir: str | os.PathLike, kind: str) -> dict[int, Path]:
     return dict(sorted(chunks.items()))
 
 
-def check_files(trial_dir: Path, meta: dict, identity: dict) -> manifest.Manifest | None:
+def check_files(
+    trial_dir: Path, meta: dict, identity: dict, recorded: manifest.Manifest | None
+) -> None:
     """TrialError unless the logs and backend.json of the trial whose checkpoint has metadata
-    `meta` are whole and as its manifest recorded them (the memory segments are checked when the
-    checkpoint is restored), those of the trial of `identity` (config_file.trial_identity); the
-    manifest, None for a trial from before manifests."""
-    recorded = recorded_manifest(trial_dir, meta)
+    `meta` are whole and as its manifest (`recorded`, as the checkpoint's restore read it: None
+    for a trial from before manifests) recorded them, those of the trial of `identity`
+    (config_file.trial_identity). The memory segments are checked when the checkpoint is
+    restored."""
     check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
     if recorded is not None:
         _check_records(trial_dir, recorded)
-    return recorded
 
 
 def recorded_manifest(trial_dir: Path, meta: dict) -> manifest.Manifest | None:
-    """The manifest of a restored checkpoint (its chain already read once by the restore)."""
+    """The manifest of the checkpoint of metadata `meta`, for a reader that restores nothing
+    (a batch's check of what it may skip); TrialError (one line) if it cannot vouch for
+    anything."""
     try:
         return manifest.read_manifest(trial_dir, meta)
     except storage.CorruptFileError as exc:

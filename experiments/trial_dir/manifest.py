@@ -165,6 +165,19 @@ class Manifest:
                 f"recorded): {remedy}"
             )
 
+    def problem_with(self, path: Path) -> str | None:
+        """What is wrong with a recorded file, in a few words (missing, damaged...), or None
+        when it is as recorded."""
+        try:
+            self.read_bytes(path, "")
+        except DamagedFileError as exc:
+            return str(exc).split(":")[0]
+        return None
+
+    def holds(self, path: Path, data: bytes) -> bool:
+        """Whether `data` are the bytes the trial recorded of the file at `path`."""
+        return entry_of(data) == self.files.get(self._name(path))
+
     def check_present(self) -> None:
         """DamagedFileError naming the first recorded file that is missing or of another
         size: a check of every file at the cost of a directory listing."""

@@ -131,32 +131,48 @@ def write_segment(
 
 def read_checkpoint(path: Path) -> tuple[dict[str, np.ndarray], dict]:
     """A checkpoint's arrays, every model's rows among them (`with_rows`), and metadata.
-    CorruptFileError if it or a segment it names cannot be read (ForeignSegmentError for a
-    segment of another trial)."""
+    CorruptFileError if it, its manifest or a segment it names cannot be read
+    (ForeignSegmentError for a segment of another trial)."""
     arrays, meta = storage.read_arrays(path)
-    return with_rows(path, arrays, meta), meta
+    return with_rows(path, arrays, meta, recorded_by(path, meta)), meta
 
 
-def with_rows(checkpoint: Path, arrays: dict[str, np.ndarray], meta: dict) -> dict:
-    """The arrays of the checkpoint at `checkpoint` (`arrays`, `meta`: as read) with each
-    model's rows whole: those of the segments its metadata names, oldest first, then its own
-    (an old checkpoint's own are all of them). CorruptFileError naming what is missing,
-    damaged or inconsistent; ForeignSegmentError for a segment of another trial."""
-    if MEMORY_KEY not in meta:
-        return arrays
+def recorded_by(checkpoint: Path, meta: dict) -> manifest.Manifest | None:
+    """The manifest of the checkpoint at `checkpoint` (metadata `meta`), its chain read once for
+    the segments and then for whatever the checkpoint covers; None before manifests.
+    CorruptFileError (manifest.DamagedFileError) if it cannot vouch for anything."""
     try:
-        return _joined(checkpoint, arrays, meta)
+        return manifest.read_manifest(checkpoint.parent, meta)
     except (KeyError, TypeError, ValueError, AttributeError) as exc:  # written by no writer
         raise storage.CorruptFileError(f"{checkpoint} cannot be restored ({exc})") from None
 
 
-def _joined(checkpoint: Path, arrays: dict[str, np.ndarray], meta: dict) -> dict:
+def with_rows(
+    checkpoint: Path,
+    arrays: dict[str, np.ndarray],
+    meta: dict,
+    recorded: manifest.Manifest | None,
+) -> dict:
+    """The arrays of the checkpoint at `checkpoint` (`arrays`, `meta`: as read; `recorded`, its
+    manifest: `recorded_by`) with each model's rows whole: those of the segments its metadata
+    names, oldest first, then its own (an old checkpoint's own are all of them), each segment's
+    bytes as the manifest recorded them. CorruptFileError naming what is missing, damaged or
+    inconsistent; ForeignSegmentError for a segment of another trial."""
+    if MEMORY_KEY not in meta:
+        return arrays
+    try:
+        return _joined(checkpoint, arrays, meta, recorded)
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:  # written by no writer
+        raise storage.CorruptFileError(f"{checkpoint} cannot be restored ({exc})") from None
+
+
+def _joined(
+    checkpoint: Path, arrays: dict[str, np.ndarray], meta: dict, recorded: manifest.Manifest | None
+) -> dict:
     """`with_rows` of a checkpoint with segments."""
     held = on_disk(meta)
     parts: dict[str, list[np.ndarray]] = {f"model{n}.{p}": [] for n in held.rows for p in _PARTS}
     found = dict.fromkeys(held.rows, 0)
-    # The segments' bytes are checked against the checkpoint's manifest, where it has one.
-    recorded = manifest.read_manifest(checkpoint.parent, meta)
     for path, rows, first in _segments(checkpoint, held.newest, meta.get("identity"), recorded):
         for n in held.rows:
             motor, key = (rows.get(f"model{n}.{p}", np.zeros((0, 0))) for p in _PARTS)

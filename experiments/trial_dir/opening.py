@@ -133,14 +133,8 @@ def _opened(
             )
         held = storage.read_json(config_path)
         _check_same_configuration(config_path, held, config)
-    try:
-        (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
-        storage.check_writable(d)
-    except OSError as exc:
-        raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
-    if held is None:
-        _write_first_config(d, config)
     identity, source = trial_identity(config), source_of(d, config)
+    _ready_to_write(d, config, held is None)
     notices: list[str] = []
     restored = prepare_resume(d, identity, source, parts, build, notices) if resume else None
     if restored is None:
@@ -210,10 +204,18 @@ def _check_same_configuration(config_path: Path, held: dict, config: dict) -> No
         )
 
 
-def _write_first_config(d: Path, config: dict) -> None:
-    """A new trial's config.json, its first file."""
-    remove_litter(d)  # under the lock: a killed first write's (`_refuse_foreign_path`)
+def _ready_to_write(d: Path, config: dict, new: bool) -> None:
+    """The directory checked writable (TrialError, one line, if not), and a `new` trial's
+    config.json written, its first file."""
     try:
+        (d / LOG_DIR).mkdir(parents=True, exist_ok=True)
+        storage.check_writable(d)
+    except OSError as exc:
+        raise TrialError(f"cannot write into {d}: {exc.strerror}") from None
+    if not new:
+        return
+    try:
+        remove_litter(d)  # under the lock: a killed first write's (`_refuse_foreign_path`)
         storage.write_json(d / CONFIG_FILE, config)
     except OSError:
         # A new trial whose first file cannot be written (disk full) leaves its folder as it

@@ -49,7 +49,7 @@ from experiments.trial_dir import (
 )
 from experiments.trial_dir.backend_record import CAPABILITIES as CAPABILITIES
 from experiments.trial_dir.backend_record import study_reach as study_reach
-from experiments.trial_dir.checks import check_files
+from experiments.trial_dir.checks import check_files, recorded_manifest
 from experiments.trial_dir.config_file import (
     UnknownSettingError,
     check_known,
@@ -197,10 +197,11 @@ class TrialReading:
         manifests writes, whatever its checkpoints say."""
         return manifest.recorded_any(self.dir)
 
-    def check_files(self, meta: dict, config: dict) -> manifest.Manifest | None:
+    def check_files(self, meta: dict, config: dict) -> None:
         """TrialError unless the logs and backend.json a checkpoint of metadata `meta` covers
-        are whole and as recorded (checks.check_files); the manifest, None before manifests."""
-        return check_files(self.dir, meta, trial_identity(config))
+        are whole and as its manifest recorded them (checks.check_files)."""
+        recorded = recorded_manifest(self.dir, meta)
+        check_files(self.dir, meta, trial_identity(config), recorded)
 
     def restored(
         self, parts_of: Callable[[dict], tuple[checkpoint.A, checkpoint.R]]
@@ -219,7 +220,7 @@ class TrialReading:
         except UnknownSettingError as exc:
             raise TrialError(str(exc)) from None
         identity = trial_identity(config)
-        agent, room, meta, fallback = checkpoint.restore_newest(
+        agent, room, meta, recorded, fallback = checkpoint.restore_newest(
             self.dir, identity, None, lambda: parts_of(config)
         )
         if fallback is not None:
@@ -230,7 +231,8 @@ class TrialReading:
             )
         if meta["iteration"] == 0:
             raise TrialError(f"{self.dir} has not reached its first checkpoint yet")
-        if check_files(self.dir, meta, identity) is None:
+        check_files(self.dir, meta, identity, recorded)
+        if recorded is None:
             manifest.warn_unchecked(self.dir)
         return config, agent, room, meta
 

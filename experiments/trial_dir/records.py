@@ -61,18 +61,16 @@ def regenerate(
     what was recorded (a line saying so is returned), and refused otherwise
     (manifest.DamagedFileError, one line)."""
     path = record_path(trial_dir, kind)
+    data = storage.json_bytes(record)  # as storage.write_json writes it
     if recorded is None or path not in recorded:
         if not path.exists():
-            storage.write_json(path, record)
+            storage.write_bytes(path, data)
         unrecorded.append(path)
         return None
-    try:
-        recorded.read_bytes(path, "")
+    problem = recorded.problem_with(path)
+    if problem is None:
         return None
-    except manifest.DamagedFileError as exc:
-        problem = str(exc).split(":")[0]
-    data = storage.json_bytes(record)
-    if manifest.entry_of(data) != recorded.files[manifest.relative(recorded.trial_dir, path)]:
+    if not recorded.holds(path, data):
         raise manifest.DamagedFileError(
             f"{problem}, and {computed_from} now gives another record than the trial wrote "
             f"({record}): it cannot be regenerated; restore it from a backup"

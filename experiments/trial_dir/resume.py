@@ -11,7 +11,7 @@ from pathlib import Path
 
 from experiments.trial_dir import manifest, memory_segments
 from experiments.trial_dir.checkpoint import A, Build, R, restore_newest
-from experiments.trial_dir.checks import check_logs, checked_chunks, recorded_manifest
+from experiments.trial_dir.checks import check_logs, checked_chunks
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
@@ -57,8 +57,7 @@ def prepare_resume(
         notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
         restored = None
     else:
-        agent, room, meta, fallback = restore_newest(trial_dir, identity, parts, build)
-        recorded = recorded_manifest(trial_dir, meta)
+        agent, room, meta, recorded, fallback = restore_newest(trial_dir, identity, parts, build)
         check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
         restored = agent, room, meta, recorded
         if "identity" not in meta:
