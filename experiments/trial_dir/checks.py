@@ -141,11 +141,11 @@ def _check_records(trial_dir: Path, recorded: manifest.Manifest) -> None:
         raise TrialError(str(exc)) from None
 
 
-def checked_chunks(trial_dir: Path, kind: str) -> dict[int, Path]:
-    """The chunks of one kind of log, of both layouts (layout.py);
+def listed_chunks(trial_dir: Path) -> dict[str, dict[int, Path]]:
+    """The chunks of every kind of log, of both layouts (layout.py), by kind and start;
     TrialError for a chunk found in both."""
     try:
-        return chunk_paths(trial_dir, kind)
+        return {kind: chunk_paths(trial_dir, kind) for kind in LOG_KINDS}
     except DuplicateChunkError as exc:
         raise TrialError(f"{exc}; nothing was changed") from None
 
@@ -155,6 +155,7 @@ def check_logs(
     iteration: int,
     identity: dict,
     recorded: manifest.Manifest | None = None,
+    listed: dict[str, dict[int, Path]] | None = None,
 ) -> None:
     """TrialError naming the first log chunk, of those a checkpoint at `iteration` covers, that
     is missing, unreadable, of another trial than `identity` (config_file.trial_identity),
@@ -163,13 +164,12 @@ def check_logs(
     iterations chunks hold 0 to `iteration` - 1 without a gap, each words chunk the multiples of
     WORDS_LOG_PERIOD its iterations chunk reaches. Chunks starting at `iteration` or later are
     work past the checkpoint (a resume rewrites them) and are not looked at. Chunks of both
-    layouts (log/iterations/ and log/words/, or side by side in log/) are read."""
+    layouts (log/iterations/ and log/words/, or side by side in log/) are read: those `listed`
+    by kind (`listed_chunks`), or listed here."""
     trial_dir = Path(trial_dir)
     own = identity
-    found = {
-        kind: {s: p for s, p in checked_chunks(trial_dir, kind).items() if s < iteration}
-        for kind in LOG_KINDS
-    }
+    listed = listed_chunks(trial_dir) if listed is None else listed
+    found = {kind: {s: p for s, p in listed[kind].items() if s < iteration} for kind in LOG_KINDS}
     if recorded is not None:
         stray = [p for kind in LOG_KINDS for p in found[kind].values() if p not in recorded]
         if stray:

@@ -24,7 +24,6 @@ import numpy as np
 
 from experiments.trial_dir import manifest, memory_segments, storage
 from experiments.trial_dir.checkpoint import A, Build, R
-from experiments.trial_dir.checks import chunk_paths
 from experiments.trial_dir.config_file import (
     EXTENSIBLE,
     UnknownSettingError,
@@ -145,20 +144,20 @@ def _opened(
             d, lock, identity, source, agent, room, unreached, counts, notices=notices
         )
     else:
-        agent, room, meta, recorded = restored
+        meta = restored.meta
         opened = OpenedTrial(
             d,
             lock,
             identity,
-            {**source, "trial": created_as(d, meta, str(source["trial"]))},
-            agent,
-            room,
+            {**source, "trial": restored.created_as},
+            restored.agent,
+            restored.room,
             best_word_distance=np.asarray(meta["best_word_distance"], dtype=float),
             counts=dict(meta["counts"]),
             iteration=int(meta["iteration"]),
             memory=memory_segments.on_disk(meta),
             manifest_pointer=meta.get(manifest.MANIFEST_KEY),
-            recorded=recorded,
+            recorded=restored.recorded,
             notices=notices,
         )
         if opened.manifest_pointer is None:
@@ -260,24 +259,6 @@ def trial_path(out_dir: str | os.PathLike) -> Path:
             ) from None
         # Anything else (a parent that is a file, no permission) is said where it is used.
     return path
-
-
-def created_as(trial_dir: Path, meta: dict, default: str) -> str:
-    """The name a trial was created as, which every row of its logs carries however its
-    directory is renamed or moved: its checkpoint's record of it, or for a checkpoint from
-    before that record, the `trial` of its first log row (`default` where neither is)."""
-    name = meta.get("trial_name")
-    if isinstance(name, str):
-        return name
-    first = chunk_paths(trial_dir, "iterations")
-    if first:
-        try:
-            rows = storage.read_table(next(iter(first.values())), ["trial"])
-        except storage.CorruptFileError:
-            return default  # the resume's checks name the damage
-        if "trial" in rows and len(rows):
-            return str(rows["trial"].iloc[0])
-    return default
 
 
 def move_derived_aside(trial_dir: Path, iteration: int) -> str | None:

@@ -7,20 +7,36 @@ moved into their folders) and the work past the checkpoint dropped, which the ru
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Generic
 
-from experiments.trial_dir import manifest, memory_segments
+from experiments.trial_dir import manifest, memory_segments, storage
 from experiments.trial_dir.checkpoint import A, Build, R, restore_newest
-from experiments.trial_dir.checks import check_logs, checked_chunks
+from experiments.trial_dir.checks import check_logs, listed_chunks
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import (
     CHECKPOINT_FILE,
     DAMAGED_CHECKPOINT_FILE,
     LOG_KINDS,
     PREVIOUS_CHECKPOINT_FILE,
+    chunk_file,
 )
 from experiments.trial_dir.old_logs import move_old_chunks
 from experiments.trial_dir.storage import remove_litter
+
+
+@dataclass
+class Resumed(Generic[A, R]):
+    """Where a resume starts: the agent and room restored from the newest usable checkpoint,
+    its metadata, its manifest (None for a checkpoint from before manifests) and the name the
+    trial was created as, which every row of its logs carries."""
+
+    agent: A
+    room: R
+    meta: dict
+    recorded: manifest.Manifest | None
+    created_as: str
 
 
 def prepare_resume(
@@ -30,23 +46,24 @@ def prepare_resume(
     parts: tuple[A, R],
     build: Build[A, R],
     notices: list[str],
-) -> tuple[A, R, dict, manifest.Manifest | None] | None:
-    """What a resume starts from: (agent, room, checkpoint meta, its manifest or None for a
-    checkpoint from before manifests) of the newest usable checkpoint of the trial of `identity`
+) -> Resumed[A, R] | None:
+    """What a resume starts from: the newest usable checkpoint of the trial of `identity`
     (config_file.trial_identity), restored into `parts` (fresh ones `build` builds where a
     restore fails half-way), whose logs are whole and as recorded, or None to start from
-    iteration 0 (no checkpoint and no logs yet). Everything is checked before anything is
-    changed; then a damaged newest checkpoint is kept as checkpoint.damaged.npz, the litter of
-    killed writers removed, old logs moved into their folders (their rows given the trial's
-    `source` columns, config_file.source_of) and the work past the checkpoint (log chunks,
-    memory segments, manifest files) dropped: the run writes it again. Appends to `notices` one
-    line per thing done or noticed. TrialError if the trial cannot be resumed (the message says
-    why and what can be done)."""
+    iteration 0 (no checkpoint and no logs yet). The trial's chunks are listed once, and
+    everything is checked before anything is changed; then a damaged newest checkpoint is kept
+    as checkpoint.damaged.npz, the litter of killed writers removed, old logs moved into their
+    folders (their rows given the trial's `source` columns, config_file.source_of) and the work
+    past the checkpoint (log chunks, memory segments, manifest files) dropped: the run writes it
+    again. Appends to `notices` one line per thing done or noticed. TrialError if the trial
+    cannot be resumed (the message says why and what can be done)."""
     newest = trial_dir / CHECKPOINT_FILE
+    listed = listed_chunks(trial_dir)
+    restored: Resumed[A, R] | None = None
     if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
         # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
         # run/trial.py): logs without one are a trial whose checkpoints were lost.
-        chunks = [p for kind in LOG_KINDS for p in checked_chunks(trial_dir, kind).values()]
+        chunks = [p for kind in LOG_KINDS for p in listed[kind].values()]
         if chunks:
             raise TrialError(
                 f"{trial_dir} holds {len(chunks)} log chunk(s) but no checkpoint "
@@ -55,11 +72,11 @@ def prepare_resume(
                 "checkpoints, or run the trial again from scratch into a new directory"
             )
         notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
-        restored = None
     else:
         agent, room, meta, recorded, fallback = restore_newest(trial_dir, identity, parts, build)
-        check_logs(trial_dir, int(meta["iteration"]), identity, recorded)
-        restored = agent, room, meta, recorded
+        check_logs(trial_dir, int(meta["iteration"]), identity, recorded, listed)
+        name = _created_as(meta, listed["iterations"], str(source["trial"]))
+        restored = Resumed(agent, room, meta, recorded, name)
         if "identity" not in meta:
             notices.append(
                 "the checkpoint predates trial identities (no seed or config hash in it): "
@@ -85,16 +102,35 @@ def prepare_resume(
             f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
             "log/words-*.parquet) into log/iterations/ and log/words/"
         )
-    _drop_work_past(trial_dir, 0 if restored is None else int(restored[2]["iteration"]))
+    _drop_work_past(trial_dir, 0 if restored is None else int(restored.meta["iteration"]), listed)
     return restored
 
 
-def _drop_work_past(trial_dir: Path, iteration: int) -> None:
+def _created_as(meta: dict, iterations: dict[int, Path], default: str) -> str:
+    """The name a trial was created as, which every row of its logs carries however its
+    directory is renamed or moved: its checkpoint's record of it, or for a checkpoint from
+    before that record, the `trial` of its first log row (of the `iterations` chunks, by start;
+    `default` where neither is)."""
+    name = meta.get("trial_name")
+    if isinstance(name, str):
+        return name
+    if iterations:
+        try:
+            rows = storage.read_table(next(iter(iterations.values())), ["trial"])
+        except storage.CorruptFileError:
+            return default  # the checks name the damage
+        if "trial" in rows and len(rows):
+            return str(rows["trial"].iloc[0])
+    return default
+
+
+def _drop_work_past(trial_dir: Path, iteration: int, listed: dict[str, dict[int, Path]]) -> None:
     """Delete what was written past the checkpoint at `iteration` (the lost work's log chunks,
-    memory segments and manifest files), which the resumed run writes again."""
+    as `listed` by kind and start, each in its kind's folder by now; memory segments; manifest
+    files), which the resumed run writes again."""
     for kind in LOG_KINDS:
-        for start, chunk in checked_chunks(trial_dir, kind).items():
+        for start in listed[kind]:
             if start >= iteration:
-                chunk.unlink()
+                (trial_dir / chunk_file(kind, start)).unlink()
     memory_segments.drop_segments_past(trial_dir, iteration)
     manifest.drop_past(trial_dir, iteration)
