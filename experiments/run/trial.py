@@ -154,6 +154,7 @@ class Trial:
         """One iteration: its row of events (`log_row`) and its learner's values."""
         interests = self.agent.interests()  # what this iteration's model was chosen from
         proposal, context, feedback = self.agent.play(self.room)
+        reached = self.agent.outcome(proposal, feedback.s)
         if proposal.motor_space == "voice":
             sound = feedback.s[_SOUND]
             distances = self.room.vocal_tract.word_distances(sound)
@@ -163,7 +164,7 @@ class Trial:
         self.counts["words_recognised"] += row["word_recognised"] != ""
         self.counts["diverged"] += row["diverged"]
         self.counts["stick_returns"] += row["stick_returned"]
-        return row, learner_values(proposal, self.agent.outcome(proposal, feedback.s), interests)
+        return row, learner_values(proposal, reached, interests)
 
     def _word_row(self) -> dict:
         row: dict[str, float] = {"iteration": self.iteration}

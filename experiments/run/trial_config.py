@@ -64,19 +64,20 @@ def typed_config(
                 **changes.get("world", {}),
             },
         )
+        # A world switch no rule of the trial's backend reads would only be recorded: refused
+        # (a TrialError, which the clause below lets through).
+        inert = inert_settings(settings.grasp, changes.get("world", {}))
+        if inert:
+            raise TrialError(
+                f"overrides.world.{inert[0]} changes nothing on the {settings.grasp} backend "
+                "(none of its rules reads it: sim/config.py); leave it out, or run it on a "
+                "backend it acts on (a batch of several backends: one batch per backend)"
+            )
         # The MJCF's lengths must equal the world's (sim/physics.py): refused now rather than
         # when the room is built, after config.json is written. A load costs milliseconds.
         PlayroomPhysics.load(world)
     except (TypeError, ValueError) as exc:  # an unknown field, or a value out of range
         raise TrialError(f"overrides do not fit the configs: {exc}") from None
-    # A world switch no rule of the trial's backend reads would only be recorded: refused.
-    inert = inert_settings(settings.grasp, changes.get("world", {}))
-    if inert:
-        raise TrialError(
-            f"overrides.world.{inert[0]} changes nothing on the {settings.grasp} backend (none "
-            "of its rules reads it: sim/config.py); leave it out, or run it on a backend it acts "
-            "on (a batch of several backends: one batch per backend)"
-        )
     if world.voice == "diva":
         # Its data is the user's: checked before anything is written, never replaced by VTL.
         try:

@@ -3,9 +3,9 @@
 A grasp backend declares what a reader of its trials needs (sim/grasping/base.py: `reach`,
 how far from the arm's base its hand can take the stick's handle; `capabilities`, whether its
 objects are solid, are pushed, whether its movements have a closed form). A trial writes that
-declaration into its directory when it first computes (`write_once`, from
-experiments/run/trial.py), and analysis and reports read it back (`read_record`), so that
-none of them rebuilds a backend's rule or tests a backend's name: a backend added to the
+declaration (`make_record`) into its directory when it first computes (writing.py, as
+records.py writes every record), and analysis and reports read it back (`read_record`), so
+that none of them rebuilds a backend's rule or tests a backend's name: a backend added to the
 registry is reported on its own terms without a line changed here.
 
 Trials written before backend.json existed lack it. They ran one of the two backends of that
@@ -26,9 +26,8 @@ from __future__ import annotations
 import functools
 import os
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
-from experiments.trial_dir import manifest, records
+from experiments.trial_dir import records
 from experiments.trial_dir.config_file import with_added_settings
 from experiments.trial_dir.layout import BACKEND_FILE
 from models import playroom_xml
@@ -45,25 +44,6 @@ def make_record(grasp: str, reach: float, capabilities: dict[str, bool]) -> dict
     if tuple(capabilities) != CAPABILITIES:
         raise ValueError(f"a backend declares the capabilities {CAPABILITIES}, not {capabilities}")
     return {"grasp": grasp, "reach": float(reach), **{k: bool(v) for k, v in capabilities.items()}}
-
-
-def write_once(
-    trial_dir: str | os.PathLike,
-    grasp: str,
-    reach: float,
-    capabilities: dict[str, bool],
-    recorded: manifest.Manifest | None,
-    unrecorded: list[Path],
-) -> str | None:
-    """Write a trial's record (`make_record`'s) unless it has one, or regenerate it when lost
-    or damaged if the backend declares exactly what was recorded (records.regenerate): the
-    first run (or, for a trial written before records, the first resume) records what its
-    backend declares. A line to tell the user, or None; manifest.DamagedFileError if it
-    cannot be regenerated."""
-    record = make_record(grasp, reach, capabilities)
-    return records.regenerate(
-        trial_dir, "backend", record, recorded, unrecorded, "the backend's declaration"
-    )
 
 
 def read_record(trial_dir: str | os.PathLike, config: dict) -> dict:

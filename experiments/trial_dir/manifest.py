@@ -289,8 +289,9 @@ def write_period(
     folder = trial_dir / MANIFEST_DIR
     folder.mkdir(exist_ok=True)
     name = manifest_name(iteration)
+    pointer = {"name": name, "sha256": entry_of(data).sha256}
     storage.write_bytes(folder / name, data)
-    return {"name": name, "sha256": entry_of(data).sha256}
+    return pointer
 
 
 def recorded_any(trial_dir: str | os.PathLike) -> bool:

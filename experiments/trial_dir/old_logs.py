@@ -22,40 +22,51 @@ from pathlib import Path
 import numpy as np
 
 from experiments.trial_dir import storage
-from experiments.trial_dir.checks import old_chunks
 from experiments.trial_dir.layout import chunk_file
 from experiments.trial_dir.log_schema import LEARNER_COLUMNS, LEARNER_DTYPE, SOURCE_COLUMNS
 
 
-def move_old_chunks(trial_dir: Path, source: dict) -> int:
-    """Bring the chunks of the old layout into their kinds' folders (module docstring), the source
+def move_old_chunks(
+    trial_dir: Path, source: dict, listed: dict[str, dict[int, Path]]
+) -> tuple[int, dict[str, dict[int, Path]]]:
+    """Bring the chunks of the old layout among those `listed` (by kind and start, of both
+    layouts: checks.listed_chunks) into their kinds' folders (module docstring), the source
     columns their rows lack set to `source` (config_file.source_of); returns how many were
-    moved. Called under the directory's lock, after the logs were checked (a chunk found in both
-    layouts stops that check)."""
+    moved, and the listing with each chunk where it lies now. Called under the directory's
+    lock, after the logs were checked (a chunk found in both layouts stops that check)."""
     moved = 0
-    for kind, start, path in old_chunks(trial_dir):
-        target = Path(trial_dir) / chunk_file(kind, start)
-        target.parent.mkdir(exist_ok=True)
-        try:
-            table = storage.read_table(path)
-        except storage.CorruptFileError:
-            # Past the checkpoint (the check read every chunk before it): the resume deletes
-            # it and writes it again.
-            os.replace(path, target)
-            moved += 1
-            continue
-        added = False
-        for position, column in enumerate(SOURCE_COLUMNS):
-            if column not in table.columns:
-                table.insert(position, column, source[column])
-                added = True
-        if kind == "iterations":
-            for column in LEARNER_COLUMNS:
-                if column not in table.columns:
-                    table[column] = np.full(len(table), np.nan, dtype=LEARNER_DTYPE)
-                    added = True
-        if added:
-            storage.write_table(path, table, plain=LEARNER_COLUMNS if kind == "iterations" else ())
+    now: dict[str, dict[int, Path]] = {}
+    for kind, chunks in listed.items():
+        now[kind] = {}
+        for start, path in chunks.items():
+            target = Path(trial_dir) / chunk_file(kind, start)
+            now[kind][start] = target
+            if path != target:
+                _move(kind, path, target, source)
+                moved += 1
+    return moved, now
+
+
+def _move(kind: str, path: Path, target: Path, source: dict) -> None:
+    """One chunk of the old layout brought to `target`, in its kind's folder."""
+    target.parent.mkdir(exist_ok=True)
+    try:
+        table = storage.read_table(path)
+    except storage.CorruptFileError:
+        # Past the checkpoint (the check read every chunk before it): the resume deletes it
+        # and writes it again.
         os.replace(path, target)
-        moved += 1
-    return moved
+        return
+    added = False
+    for position, column in enumerate(SOURCE_COLUMNS):
+        if column not in table.columns:
+            table.insert(position, column, source[column])
+            added = True
+    if kind == "iterations":
+        for column in LEARNER_COLUMNS:
+            if column not in table.columns:
+                table[column] = np.full(len(table), np.nan, dtype=LEARNER_DTYPE)
+                added = True
+    if added:
+        storage.write_table(path, table, plain=LEARNER_COLUMNS if kind == "iterations" else ())
+    os.replace(path, target)

@@ -155,15 +155,12 @@ def _opened(
             best_word_distance=np.asarray(meta["best_word_distance"], dtype=float),
             counts=dict(meta["counts"]),
             iteration=int(meta["iteration"]),
-            memory=memory_segments.on_disk(meta),
+            memory=restored.memory,
             manifest_pointer=meta.get(manifest.MANIFEST_KEY),
             recorded=restored.recorded,
+            unrecorded=restored.unrecorded,
             notices=notices,
         )
-        if opened.manifest_pointer is None:
-            # A trial written before manifests: its next checkpoint records every data file
-            # it holds, as checked by the resume, and it is checked from then on.
-            opened.unrecorded = manifest.data_files(d)
         if held is not None:
             _extend_if_asked(d, held, config, opened.iteration, notices)
     readme = d / LOG_DIR / LOG_README_FILE

@@ -20,7 +20,6 @@ from experiments.trial_dir.layout import (
     DAMAGED_CHECKPOINT_FILE,
     LOG_KINDS,
     PREVIOUS_CHECKPOINT_FILE,
-    chunk_file,
 )
 from experiments.trial_dir.old_logs import move_old_chunks
 from experiments.trial_dir.storage import remove_litter
@@ -29,14 +28,18 @@ from experiments.trial_dir.storage import remove_litter
 @dataclass
 class Resumed(Generic[A, R]):
     """Where a resume starts: the agent and room restored from the newest usable checkpoint,
-    its metadata, its manifest (None for a checkpoint from before manifests) and the name the
-    trial was created as, which every row of its logs carries."""
+    its metadata, its manifest (None for a checkpoint from before manifests), the name the
+    trial was created as, which every row of its logs carries, what its memory segments hold,
+    and the data files its next checkpoint records (a trial from before manifests: every one it
+    holds, as the resume checked them; else none yet)."""
 
     agent: A
     room: R
     meta: dict
     recorded: manifest.Manifest | None
     created_as: str
+    memory: memory_segments.MemoryOnDisk
+    unrecorded: list[Path]
 
 
 def prepare_resume(
@@ -50,17 +53,20 @@ def prepare_resume(
     """What a resume starts from: the newest usable checkpoint of the trial of `identity`
     (config_file.trial_identity), restored into `parts` (fresh ones `build` builds where a
     restore fails half-way), whose logs are whole and as recorded, or None to start from
-    iteration 0 (no checkpoint and no logs yet). The trial's chunks are listed once, and
-    everything is checked before anything is changed; then a damaged newest checkpoint is kept
-    as checkpoint.damaged.npz, the litter of killed writers removed, old logs moved into their
-    folders (their rows given the trial's `source` columns, config_file.source_of) and the work
-    past the checkpoint (log chunks, memory segments, manifest files) dropped: the run writes it
-    again. Appends to `notices` one line per thing done or noticed. TrialError if the trial
-    cannot be resumed (the message says why and what can be done)."""
+    iteration 0 (no checkpoint and no logs yet). The trial's chunks are listed once, after the
+    checkpoint is restored, and everything is checked before anything is changed; then a
+    damaged newest checkpoint is kept as checkpoint.damaged.npz, the litter of killed writers
+    removed, old logs moved into their folders (their rows given the trial's `source` columns,
+    config_file.source_of) and the work past the checkpoint (log chunks, memory segments,
+    manifest files) dropped: the run writes it again. Appends to `notices` one line per thing
+    done or noticed. TrialError if the trial cannot be resumed (the message says why and what
+    can be done)."""
     newest = trial_dir / CHECKPOINT_FILE
+    checkpointed = newest.exists() or (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists()
+    newest_usable = restore_newest(trial_dir, identity, parts, build) if checkpointed else None
     listed = listed_chunks(trial_dir)
-    restored: Resumed[A, R] | None = None
-    if not newest.exists() and not (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists():
+    restored = None
+    if newest_usable is None:
         # A run writes a checkpoint at iteration 0 before its first chunk (experiments/
         # run/trial.py): logs without one are a trial whose checkpoints were lost.
         chunks = [p for kind in LOG_KINDS for p in listed[kind].values()]
@@ -73,10 +79,10 @@ def prepare_resume(
             )
         notices.append(f"{trial_dir} holds no checkpoint yet: starting it from iteration 0")
     else:
-        agent, room, meta, recorded, fallback = restore_newest(trial_dir, identity, parts, build)
+        agent, room, meta, recorded, fallback = newest_usable
         check_logs(trial_dir, int(meta["iteration"]), identity, recorded, listed)
         name = _created_as(meta, listed["iterations"], str(source["trial"]))
-        restored = Resumed(agent, room, meta, recorded, name)
+        restored = agent, room, meta, recorded, name
         if "identity" not in meta:
             notices.append(
                 "the checkpoint predates trial identities (no seed or config hash in it): "
@@ -96,14 +102,28 @@ def prepare_resume(
         notices.append(
             f"removed {len(litter)} temporary file(s) of a killed writer: {', '.join(litter)}"
         )
-    moved = move_old_chunks(trial_dir, source)
+    moved, listed = move_old_chunks(trial_dir, source, listed)
     if moved:
         notices.append(
             f"moved {moved} log chunk(s) of the old layout (log/iterations-*.parquet, "
             "log/words-*.parquet) into log/iterations/ and log/words/"
         )
-    _drop_work_past(trial_dir, 0 if restored is None else int(restored.meta["iteration"]), listed)
-    return restored
+    # The work past the checkpoint (its log chunks, memory segments and manifest files), which
+    # the run writes again.
+    iteration = 0 if restored is None else int(restored[2]["iteration"])
+    for by_start in listed.values():
+        for start, path in by_start.items():
+            if start >= iteration:
+                path.unlink()
+    memory_segments.drop_segments_past(trial_dir, iteration)
+    manifest.drop_past(trial_dir, iteration)
+    if restored is None:
+        return None
+    agent, room, meta, recorded, name = restored
+    # A trial written before manifests: its next checkpoint records every data file it holds,
+    # as checked above, and it is checked from then on.
+    unrecorded = manifest.data_files(trial_dir) if meta.get(manifest.MANIFEST_KEY) is None else []
+    return Resumed(agent, room, meta, recorded, name, memory_segments.on_disk(meta), unrecorded)
 
 
 def _created_as(meta: dict, iterations: dict[int, Path], default: str) -> str:
@@ -122,15 +142,3 @@ def _created_as(meta: dict, iterations: dict[int, Path], default: str) -> str:
         if "trial" in rows and len(rows):
             return str(rows["trial"].iloc[0])
     return default
-
-
-def _drop_work_past(trial_dir: Path, iteration: int, listed: dict[str, dict[int, Path]]) -> None:
-    """Delete what was written past the checkpoint at `iteration` (the lost work's log chunks,
-    as `listed` by kind and start, each in its kind's folder by now; memory segments; manifest
-    files), which the resumed run writes again."""
-    for kind in LOG_KINDS:
-        for start in listed[kind]:
-            if start >= iteration:
-                (trial_dir / chunk_file(kind, start)).unlink()
-    memory_segments.drop_segments_past(trial_dir, iteration)
-    manifest.drop_past(trial_dir, iteration)

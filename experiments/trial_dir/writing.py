@@ -67,7 +67,7 @@ class RoomState(Protocol):
 class Declared:
     """What a run declares of itself before it computes: the inputs it computes with, beside the
     machine and code (provenance.json: provenance_file.record_start), and what its grasp
-    backend declares (backend.json: backend_record.write_once)."""
+    backend declares (backend.json: records.regenerate)."""
 
     inputs: dict[str, str] | None
     grasp: str
@@ -101,44 +101,35 @@ class TrialWriter(Generic[A, R]):
     def _record_declared(self, declared: Declared, finished: bool) -> None:
         """What the run declares, recorded before it computes, the lines to tell the user
         added to the opening's notices: who computes from here on (provenance.json), unless
-        the trial is `finished`, else its summary regenerated if lost or damaged since
-        (records.regenerate); what its backend declares, for analysis to read (backend.json),
-        written once, or rewritten when lost or damaged if the backend declares what the trial
-        recorded (backend_record.write_once). A finished trial from before backend.json is left
-        without one: readers compute it from its config."""
+        the trial is `finished`; what its backend declares, for analysis to read
+        (backend.json); and a finished trial's summary. Each record is written once, or
+        rewritten when lost or damaged if what computes it now gives what the trial recorded
+        (records.regenerate). A finished trial from before backend.json is left without one:
+        readers compute it from its config."""
         notices = self.opened.notices
         if not finished:
             notices += record_start(self.dir, self.opened.iteration, declared.inputs)
-        elif (
-            self._recorded is not None
-            and records.record_path(self.dir, "summary") in self._recorded
-        ):
+        backend = None
+        if not finished or (self.dir / BACKEND_FILE).exists() or self._recorded is not None:
+            backend = backend_record.make_record(
+                declared.grasp, declared.reach, declared.capabilities
+            )
+        wanted: dict[str, tuple[dict, str]] = {}  # in this order: the summary first
+        summary_path = records.record_path(self.dir, "summary")
+        if finished and self._recorded is not None and summary_path in self._recorded:
             opened = self.opened
             summary = records.summary_record(
                 opened.iteration, opened.counts, opened.best_word_distance
             )
+            wanted["summary"] = summary, "the trial's last checkpoint"
+        if backend is not None:
+            wanted["backend"] = backend, "the backend's declaration"
+        for kind, (record, computed_from) in wanted.items():
             notice = records.regenerate(
-                self.dir,
-                "summary",
-                summary,
-                self._recorded,
-                self._unrecorded,
-                "the trial's last checkpoint",
+                self.dir, kind, record, self._recorded, self._unrecorded, computed_from
             )
             if notice is not None:
                 notices.append(notice)
-        if finished and not (self.dir / BACKEND_FILE).exists() and self._recorded is None:
-            return
-        notice = backend_record.write_once(
-            self.dir,
-            declared.grasp,
-            declared.reach,
-            declared.capabilities,
-            self._recorded,
-            self._unrecorded,
-        )
-        if notice is not None:
-            notices.append(notice)
 
     def _write_chunk(self, kind: str, table: pd.DataFrame, plain: tuple[str, ...]) -> None:
         """One chunk of a log, of the period being closed, in its kind's folder, its source
@@ -176,6 +167,7 @@ class TrialWriter(Generic[A, R]):
         memory = memory_segments.write_segment(
             self.dir, agent, self._memory, iteration, self.opened.identity
         )
+        memory_meta = memory.meta()
         if memory.newest != self._memory.newest:
             self._unrecorded.append(self.dir / MEMORY_DIR / str(memory.newest))
         pointer = manifest.write_period(
@@ -196,7 +188,7 @@ class TrialWriter(Generic[A, R]):
             "identity": self.opened.identity,
             # The name the trial was created as, which its log rows carry wherever it lies.
             "trial_name": self.opened.source["trial"],
-            memory_segments.MEMORY_KEY: memory.meta(),
+            memory_segments.MEMORY_KEY: memory_meta,
             manifest.MANIFEST_KEY: pointer,
         }
         newest = self.dir / CHECKPOINT_FILE

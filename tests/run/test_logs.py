@@ -20,7 +20,7 @@ from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.trial_dir import storage
-from experiments.trial_dir.checks import DuplicateChunkError, check_logs
+from experiments.trial_dir.checks import DuplicateChunkError, check_logs, listed_chunks
 from experiments.trial_dir.config_file import source_of, trial_identity
 from experiments.trial_dir.errors import TrialError
 from experiments.trial_dir.layout import LOG_DIR, LOG_README_FILE
@@ -257,7 +257,8 @@ def test_a_resume_killed_mid_move_is_finished_by_the_next(old_trial):
     table.insert(0, "trial", "trial")
     storage.write_table(first, table)
     check_logs(old, 120, trial_identity(open_for_reading(old).config()))
-    assert move_old_chunks(old, source_of(old, config)) == 4
+    moved, _ = move_old_chunks(old, source_of(old, config), listed_chunks(old))
+    assert moved == 4
     assert not list((old / LOG_DIR).glob("*.parquet"))
     check_logs(old, 120, trial_identity(open_for_reading(old).config()))
     assert read_log(old)["trial"].eq("trial").all()

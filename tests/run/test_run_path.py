@@ -1,9 +1,9 @@
 """A trial's opening reads from top to bottom (experiments/run/trial.py, through the trial
 directory's writing face, experiments/trial_dir/writing.py, to its opening): the trial types its
-settings, builds its parts, then only asks the writing face, which calls each stage once, in
-order, and no module of experiments is called back by one it called, for a new trial and for a
-resume. Followed with a profiler over the calls
-between modules, from the trial's creation to its first iteration."""
+settings, builds its parts, then only asks the writing face, which calls each stage in one
+stretch, in order, and no module of experiments is called back by one it called, for a new
+trial and for a resume. Followed with a profiler over the calls between modules, from the
+trial's creation to its first iteration."""
 
 from __future__ import annotations
 
@@ -21,8 +21,14 @@ ROOT = Path(experiments.__file__).resolve().parent
 # What the trial calls, in order: its settings typed, its parts built, then the directory's
 # writing face only (the opening, who computes, what the backend declares).
 CALLED = ["run.trial_config", "run.trial_parts", "trial_dir.writing"]
-# The writing face's stages, in the order it calls them.
-STAGES = ["trial_dir.opening", "trial_dir.provenance_file", "trial_dir.backend_record"]
+# The writing face's stages, in the order it calls them: the opening, who computes, what the
+# backend declares, then the records written or regenerated (one call per record).
+STAGES = [
+    "trial_dir.opening",
+    "trial_dir.provenance_file",
+    "trial_dir.backend_record",
+    "trial_dir.records",
+]
 
 # What every step of the opening reads and writes through: the trial directory's files.
 FILE_LAYERS = {f"trial_dir.{m}" for m in ("storage", "layout", "config_file", "manifest")}
@@ -93,7 +99,9 @@ def test_a_trial_opens_top_to_bottom(tmp_path, resume):
         settings = TrialSettings(iterations=40, seed=1, checkpoint_every=10)
     entered, edges = _calls(lambda: Trial(out, settings, resume=resume))
     assert list(dict.fromkeys(entered["run.trial"])) == CALLED
-    assert entered["trial_dir.writing"] == STAGES
+    stages = entered["trial_dir.writing"]
+    # Each stage in one stretch, in order: none entered again once a later one was.
+    assert [m for i, m in enumerate(stages) if i == 0 or stages[i - 1] != m] == STAGES
     assert _cycle(edges) is None
     # The opening enters each of its own steps once (the disk estimate, the lock, then for a
     # resume the checks of what lies in the directory; a new trial's litter is removed by the
