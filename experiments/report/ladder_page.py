@@ -183,12 +183,6 @@ def completeness_lines(check: pd.DataFrame) -> list[str]:
         lines.append(
             f"| {r['rung']} | {r['seeds']} | " + " | ".join(missing) + f" | {r['not_finite']} |"
         )
-    verdict = (
-        "Complete: every rung holds every seed in its own world and in both test worlds."
-        if check["complete"].all()
-        else "Incomplete: the steps are taken on the seeds every rung holds; the rows above "
-        "say what each rung lacks."
-    )
     return [
         "What it checks: that every rung (and every rung beside the ladder) holds every seed "
         "any rung holds, in its own world and in each test world; a value that is not finite "
@@ -197,8 +191,35 @@ def completeness_lines(check: pd.DataFrame) -> list[str]:
         "",
         *lines,
         "",
-        verdict,
+        completeness_verdict(check),
     ]
+
+
+def completeness_verdict(check: pd.DataFrame) -> str:
+    """One sentence: complete; or the seeds the steps use when rungs merely hold different
+    seeds (each trial tested in every world, as designed when the ends hold more seeds); or
+    incomplete, naming each rung whose trials lack a test world (a cross-evaluation missing)."""
+    if check["complete"].all():
+        return "Complete: every rung holds every seed in its own world and in both test worlds."
+    untested = []
+    for r in check.to_dict("records"):
+        worlds = [w for w in ladder.WORLDS if r[f"missing_{w}"] != r["missing_own"]]
+        if worlds:
+            untested.append(f"{r['rung']} ({', '.join(worlds)})")
+    if untested:
+        return (
+            "Incomplete: some trials were not tested in every world: "
+            + "; ".join(untested)
+            + ". The steps are taken on the seeds every rung holds in each world."
+        )
+    lacking = set().union(*check["missing_own"])
+    fewer = ", ".join(r["rung"] for r in check.to_dict("records") if r["missing_own"])
+    return (
+        f"Every trial was tested in both test worlds. The rungs hold different seeds: {fewer} "
+        f"lack {seeds_text(sorted(lacking))}. Every step is taken on the seeds every rung holds; "
+        "the others enter only comparisons of rungs that both hold them (the whole on every "
+        "seed of the first and last rungs)."
+    )
 
 
 def markdown(

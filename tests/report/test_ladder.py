@@ -397,3 +397,17 @@ def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alon
     # The rungs' means the page shows: over the seeds every rung holds.
     mean_a = own[(own["rung"] == "A") & own["seed"].isin(ladder_seeds)][KEY].mean()
     assert f"| ring 1 | {100 * mean_a:.1f} |" in page
+
+
+def test_the_verdict_tells_rungs_holding_other_seeds_from_trials_missing_a_test_world():
+    """Ends holding more seeds than the middle rungs, every trial tested in both worlds: the
+    page says which seeds the steps use, not "Incomplete"; a trial missing a test world is."""
+    from experiments.report.ladder_page import completeness_verdict
+
+    values = _values(LEVELS, drop=("B", 3))
+    verdict = completeness_verdict(ladder.completeness(values, ["A", "B", "C"]))
+    assert "Incomplete" not in verdict
+    assert "B lack 3" in verdict and "Every step is taken on the seeds every rung holds" in verdict
+    untested = values[~((values["rung"] == "C") & (values["tested"] == "physical"))]
+    verdict = completeness_verdict(ladder.completeness(untested, ["A", "B", "C"]))
+    assert verdict.startswith("Incomplete") and "C (physical)" in verdict
