@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from trial_batches import batch
+from trial_recompute import ladder_case
 
 from experiments.analysis import step_split
 from experiments.analysis.trial_tests import holm
@@ -339,35 +340,6 @@ def test_one_order_is_worded_as_each_rule_given_the_rules_before_it():
     assert "given the rules before it" in figure.get_suptitle()
 
 
-def _recomputed(trials: pd.DataFrame, case: dict, seeds: set[int]) -> dict:
-    """A test of the page computed from the per-trial data alone, with scipy: B minus A on the
-    given seeds, pairs with an empty cell left out."""
-    from scipy import stats
-
-    def values(rung: str, tested: str) -> pd.Series:
-        mine = trials[(trials["rung"] == rung) & (trials["tested"] == tested)]
-        return mine.set_index("seed")[case["key"]].loc[lambda v: v.index.isin(seeds)]
-
-    a, b = case["from"], case["to"]
-    if case["part"] == "step":
-        diff = values(b, "own") - values(a, "own")
-    elif case["part"] == "both_in_world":
-        diff = values(b, case["world"]) - values(a, case["world"])
-    else:
-        w = case["world"]
-        diff = (values(b, "own") - values(b, w)) - (values(a, "own") - values(a, w))
-    d = diff.dropna().to_numpy()
-    half = stats.t.ppf(0.975, len(d) - 1) * stats.sem(d)
-    return {
-        "mean": d.mean(),
-        "low": d.mean() - half,
-        "high": d.mean() + half,
-        "p": stats.ttest_1samp(d, 0.0).pvalue,
-        "p_rank": stats.wilcoxon(d, zero_method="pratt").pvalue,
-        "n": len(d),
-    }
-
-
 def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alone():
     """ladder-trials.csv, the data published beside the page, holds all a reader needs: each
     test's mean, interval, t and signed-rank p, and each rung's mean, computed from it with
@@ -389,7 +361,7 @@ def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alon
     assert {r["kind"] for r in made} == {"step", "whole", "whole_all", "beside"}
     for case in made:
         seeds = ladder_seeds if case["kind"] in ("step", "whole") else every
-        again = _recomputed(trials, case, seeds)
+        again = ladder_case(trials, case, seeds)
         for column, value in again.items():
             assert case[column] == pytest.approx(value, rel=1e-9), (case, column)
         if case["part"] == "step":

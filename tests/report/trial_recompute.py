@@ -1,6 +1,7 @@
-"""A comparison page's tests computed again from its per-trial data alone (comparison-trials.csv),
-with scipy, as a reader would: for tests/report/test_comparison_data.py and the real page's
-test in tests/report/test_report.py."""
+"""A page's tests computed again from its per-trial data alone, with scipy, as a reader would: a
+comparison page's (comparison-trials.csv: tests/report/test_comparison_data.py, test_report.py,
+test_comparison_doc_data.py) and the contact ladder's (ladder-trials.csv: test_ladder.py,
+test_ladder_doc_data.py)."""
 
 from __future__ import annotations
 
@@ -91,3 +92,43 @@ def check_trials_file(out: Path, page: str, tests: list[dict]) -> pd.DataFrame:
     assert trials["evaluated_on"].ne("not recorded").all()
     check_tests_again(trials, tests)
     return trials
+
+
+def ladder_case(trials: pd.DataFrame, case: dict, seeds: set[int]) -> dict[str, float]:
+    """One test of the ladder's family (`case`: key, from, to, part, world) from its per-trial
+    table (a row per rung, world tested in and seed): B minus A on the given seeds, the step in
+    the rungs' own worlds or a part of its split in `world`, pairs with an empty cell left out.
+    Its mean, 95% t interval, t p and signed-rank p (NaN where every pair is equal), pairs."""
+
+    def values(rung: str, tested: str) -> pd.Series:
+        mine = trials[(trials["rung"] == rung) & (trials["tested"] == tested)]
+        return mine.set_index("seed")[case["key"]].loc[lambda v: v.index.isin(seeds)]
+
+    a, b, world = case["from"], case["to"], case.get("world")
+    if case["part"] == "step":
+        diff = values(b, "own") - values(a, "own")
+    elif case["part"] == "both_in_world":
+        diff = values(b, world) - values(a, world)
+    else:
+        diff = (values(b, "own") - values(b, world)) - (values(a, "own") - values(a, world))
+    d = diff.dropna().to_numpy()
+    d = d[np.isfinite(d)]
+    if len(d) < 2 or np.all(d == d[0]):
+        mean = d.mean() if len(d) else math.nan
+        return {
+            "mean": mean,
+            "low": mean,
+            "high": mean,
+            "p": math.nan,
+            "p_rank": math.nan,
+            "n": len(d),
+        }
+    half = stats.t.ppf(0.975, len(d) - 1) * stats.sem(d)
+    return {
+        "mean": d.mean(),
+        "low": d.mean() - half,
+        "high": d.mean() + half,
+        "p": stats.ttest_1samp(d, 0.0).pvalue,
+        "p_rank": stats.wilcoxon(d, zero_method="pratt").pvalue,
+        "n": len(d),
+    }
