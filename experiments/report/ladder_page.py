@@ -173,8 +173,15 @@ def _seeds_or_none(seeds: list[int]) -> str:
     return seeds_text(seeds) if seeds else "none"
 
 
-def completeness_lines(check: pd.DataFrame) -> list[str]:
-    """The completeness check (ladder.completeness) and its verdict."""
+# What the seeds some rungs hold beyond the common ones enter, on a ladder's page.
+LADDER_OTHER_SEEDS = (
+    "Every step is taken on the seeds every rung holds; the others enter only comparisons of "
+    "rungs that both hold them (the whole on every seed of the first and last rungs)."
+)
+
+
+def completeness_lines(check: pd.DataFrame, other_seeds: str = LADDER_OTHER_SEEDS) -> list[str]:
+    """The completeness check (ladder.completeness) and its verdict (`completeness_verdict`)."""
     worlds = [ladder.OWN, *ladder.WORLDS]
     head = ["rung", "seeds", *(f"seeds lacking ({w})" for w in worlds), "values not finite"]
     lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
@@ -191,14 +198,15 @@ def completeness_lines(check: pd.DataFrame) -> list[str]:
         "",
         *lines,
         "",
-        completeness_verdict(check),
+        completeness_verdict(check, other_seeds),
     ]
 
 
-def completeness_verdict(check: pd.DataFrame) -> str:
-    """One sentence: complete; or the seeds the steps use when rungs merely hold different
-    seeds (each trial tested in every world, as designed when the ends hold more seeds); or
-    incomplete, naming each rung whose trials lack a test world (a cross-evaluation missing)."""
+def completeness_verdict(check: pd.DataFrame, other_seeds: str = LADDER_OTHER_SEEDS) -> str:
+    """The verdict: complete; or, where the rungs merely hold different seeds (each trial tested
+    in every world, as designed when the ends hold more seeds), which rungs lack which seeds
+    and `other_seeds`, what the page does with the seeds not every rung holds; or incomplete,
+    naming each rung whose trials lack a test world (a cross-evaluation missing)."""
     if check["complete"].all():
         return "Complete: every rung holds every seed in its own world and in both test worlds."
     untested = []
@@ -216,9 +224,7 @@ def completeness_verdict(check: pd.DataFrame) -> str:
     fewer = ", ".join(r["rung"] for r in check.to_dict("records") if r["missing_own"])
     return (
         f"Every trial was tested in both test worlds. The rungs hold different seeds: {fewer} "
-        f"lack {seeds_text(sorted(lacking))}. Every step is taken on the seeds every rung holds; "
-        "the others enter only comparisons of rungs that both hold them (the whole on every "
-        "seed of the first and last rungs)."
+        f"lack {seeds_text(sorted(lacking))}. {other_seeds}"
     )
 
 

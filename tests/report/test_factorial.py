@@ -68,3 +68,21 @@ def test_a_design_of_other_than_four_cells_is_refused_in_one_line(batches, tmp_p
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "a 2 x 2 design has 4 cells" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_cells_holding_more_seeds_than_others_are_said_so_and_enter_no_contrast():
+    """The real designs cross 16-seed cells with 32-seed rungs and the comparison's 64: every
+    contrast is on the seeds all four hold, and the page says so (not "Incomplete", and not
+    the ladder's whole on every seed, which a factorial does not compute)."""
+    values = _values()
+    values = pd.concat([values.assign(tested=t) for t in ("own", *ladder.WORLDS)])
+    values = values[(values["rung"] != "first") | (values["seed"] < 4)]
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    files = factorial_files(
+        _read(values, {c: _config("kinematic") for c in CELLS}), cells, ("a", "b"), "cmd"
+    )
+    tests = pd.read_csv(io.BytesIO(files["factorial.csv"]))
+    assert set(tests["n"]) == {4}
+    page = files["factorial.md"].decode()
+    assert "first lack 4–7. Every contrast is taken on the seeds every cell holds" in page
+    assert "Incomplete" not in page and "the whole" not in page.split("## Completeness")[1]

@@ -23,17 +23,17 @@ from sim.config import world_preset
 from sim.vocal.config import VoiceConfig
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
-PAGE = DOCS / "contact-ladder.md"
-DATA = DOCS / "data" / "contact-ladder-trials.csv"
+# Each published ladder page (`playroom ladder`) and the per-trial data beside it.
+PAGES = {"contact-ladder.md": "contact-ladder-trials.csv"}
 
 
 def _rungs(text: str) -> tuple[list[str], list[str]]:
     """The ladder's rungs and those beside it, in order, from the command the page names."""
-    command = re.search(r"Written by `(playroom ladder [^`]*)`", text).group(1).split()
-    at = command.index("--beside")
-    names = [word.split("=")[0] for word in command if "=" in word]
-    before = [word.split("=")[0] for word in command[:at] if "=" in word]
-    return before, names[len(before) :]
+    words = re.search(r"Written by `(playroom ladder [^`]*)`", text).group(1).split()
+    cut = words.index("--beside") if "--beside" in words else len(words)
+    return [w.split("=")[0] for w in words[:cut] if "=" in w], [
+        w.split("=")[0] for w in words[cut:] if "=" in w
+    ]
 
 
 def _tables(text: str, head: str) -> dict[str, list[str]]:
@@ -48,10 +48,10 @@ def _tables(text: str, head: str) -> dict[str, list[str]]:
     return rows
 
 
-@pytest.fixture(scope="module")
-def page():
-    text = PAGE.read_text()
-    trials = pd.read_csv(DATA)
+@pytest.fixture(scope="module", params=PAGES)
+def page(request):
+    text = (DOCS / request.param).read_text()
+    trials = pd.read_csv(DOCS / "data" / PAGES[request.param])
     order, beside = _rungs(text)
     world, voice = world_preset("study"), VoiceConfig()
     hand = float(sum(world.segment_lengths))
