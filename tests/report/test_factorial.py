@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from test_ladder import KEY, _config, _read
+from trial_recompute import check_factorial_page
 
 from experiments.cli.main import main
 from experiments.report import ladder
@@ -86,3 +87,24 @@ def test_cells_holding_more_seeds_than_others_are_said_so_and_enter_no_contrast(
     page = files["factorial.md"].decode()
     assert "first lack 4–7. Every contrast is taken on the seeds every cell holds" in page
     assert "Incomplete" not in page and "the whole" not in page.split("## Completeness")[1]
+
+
+def test_every_cell_of_the_page_is_computed_again_from_its_per_trial_data_alone():
+    """factorial-trials.csv holds all a reader needs: each contrast's mean, interval, t and
+    signed-rank p, the Holm stars and counts, and each cell's mean, computed again with scipy
+    (trial_recompute.check_factorial_page, which also checks the published pages)."""
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    read = _read(_values(), {c: _config("kinematic") for c in CELLS})
+    named = " ".join(f"{c}={c}" for c in CELLS)
+    command = f'playroom factorial {named} --factors "catch rule" "servo arm" --out x'
+    files = factorial_files(read, cells, ("catch rule", "servo arm"), command)
+    page = files["factorial.md"].decode()
+    trials = pd.read_csv(io.BytesIO(files["factorial-trials.csv"]))
+    check_factorial_page(page, trials, read.measures)
+    # Another trial's value, or a cell of the table written by hand, fails the check.
+    moved = trials[KEY].where(trials["rung"] != "both", trials[KEY] + 0.01)
+    with pytest.raises(AssertionError):
+        check_factorial_page(page, trials.assign(**{KEY: moved}), read.measures)
+    mean = f"{100 * trials.loc[trials['rung'] == 'neither', KEY].mean():.1f}"
+    with pytest.raises(AssertionError):
+        check_factorial_page(page.replace(f"| {mean} |", "| 0.0 |", 1), trials, read.measures)
