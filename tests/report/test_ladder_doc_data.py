@@ -13,14 +13,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from trial_recompute import ladder_case
+from trial_recompute import ladder_case, study_headline
 
-from experiments.analysis.geometry import Geometry
 from experiments.analysis.trial_tests import holm, survives
 from experiments.report import ladder
 from experiments.report.paired_text import cell_text, level_text
-from sim.config import world_preset
-from sim.vocal.config import VoiceConfig
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 # Each published ladder page (`playroom ladder`) and the per-trial data beside it.
@@ -53,10 +50,7 @@ def page(request):
     text = (DOCS / request.param).read_text()
     trials = pd.read_csv(DOCS / "data" / PAGES[request.param])
     order, beside = _rungs(text)
-    world, voice = world_preset("study"), VoiceConfig()
-    hand = float(sum(world.segment_lengths))
-    geometry = Geometry(hand, hand + world.stick_length, voice.recognition_distance, 0)
-    measures = ladder.headline(geometry)
+    measures = study_headline()
     own = trials[trials["tested"] == ladder.OWN]
     common = set.intersection(*(set(own.loc[own["rung"] == r, "seed"]) for r in order))
     ends = [set(own.loc[own["rung"] == r, "seed"]) for r in (order[0], order[-1])]

@@ -180,3 +180,17 @@ def check_factorial_page(page: str, trials: pd.DataFrame, measures: list) -> Non
     rank = int(sum(survives(p) for p in made["p_rank_holm"]))
     assert f"One family of {len(tests)} tests" in page and f"; {len(made)} could be made." in page
     assert f"{t} survive with the paired t, {rank} with the signed-rank test." in page
+
+
+def study_headline() -> list:
+    """The ladder's and factorial's headline measures (labels and kinds) for the study preset's
+    world and voice, as the published pages name them."""
+    from experiments.analysis.geometry import Geometry
+    from experiments.report import ladder
+    from sim.config import world_preset
+    from sim.vocal.config import VoiceConfig
+
+    world, voice = world_preset("study"), VoiceConfig()
+    hand = float(sum(world.segment_lengths))
+    geometry = Geometry(hand, hand + world.stick_length, voice.recognition_distance, 0)
+    return ladder.headline(geometry)
