@@ -21,7 +21,10 @@ from experiments.report.paired_text import cell_text, level_text
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 # Each published ladder page (`playroom ladder`) and the per-trial data beside it.
-PAGES = {"contact-ladder.md": "contact-ladder-trials.csv"}
+PAGES = {
+    "contact-ladder.md": "contact-ladder-trials.csv",
+    "contact-unbundled.md": "contact-unbundled-trials.csv",
+}
 
 
 def _rungs(text: str) -> tuple[list[str], list[str]]:
