@@ -108,7 +108,7 @@ def markdown(
         f"what {factors[0]}'s effect changes when {factors[1]} is on. Per-trial data: "
         "[factorial-trials.csv](factorial-trials.csv).",
         "",
-        *rungs_table(cells, [], read.own),
+        *rungs_table(cells, [], read.own, against_first=True),
         "",
         "## Each rule with the other off and on, main effects, interaction",
         "",

@@ -42,12 +42,16 @@ def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[d
 
 
 def rungs_table(
-    rungs: list[ladder.Rung], beside: list[ladder.Rung], own: dict[str, BatchResults]
+    rungs: list[ladder.Rung],
+    beside: list[ladder.Rung],
+    own: dict[str, BatchResults],
+    against_first: bool = False,
 ) -> list[str]:
     """One row per rung: its batch, everything it changes from the rung before (a rung beside
-    the ladder: from the last rung) (rung_change.describe), its trials and where they were
-    computed."""
-    head = "| rung | batch | changes from the rung before | trials (seeds) | computed on |"
+    the ladder: from the last rung; `against_first`, a factorial's cells, which have no order:
+    from the first) (rung_change.describe), its trials and where they were computed."""
+    against = f"changes from {rungs[0].name}" if against_first else "changes from the rung before"
+    head = f"| rung | batch | {against} | trials (seeds) | computed on |"
     lines = [head, "|---|---|---|---|---|"]
     before = None
     last = None
@@ -65,7 +69,8 @@ def rungs_table(
             f"| {rung.name} | {rung.batch_dir.name} ({group}) | {change} | "
             f"{len(seeds)} ({seeds_text(seeds)}) | {machines_text(results)} |"
         )
-        before = world
+        if before is None or not against_first:
+            before = world
         if rung == rungs[-1]:
             last = world
     return lines

@@ -108,3 +108,22 @@ def test_every_cell_of_the_page_is_computed_again_from_its_per_trial_data_alone(
     mean = f"{100 * trials.loc[trials['rung'] == 'neither', KEY].mean():.1f}"
     with pytest.raises(AssertionError):
         check_factorial_page(page.replace(f"| {mean} |", "| 0.0 |", 1), trials, read.measures)
+
+
+def test_each_cell_says_what_it_changes_from_the_cell_of_neither_rule():
+    """A factorial's cells have no order: the page lists what each changes from the first
+    cell (neither rule), so that the cell of both names both rules."""
+    configs = {
+        "neither": _config("kinematic"),
+        "first": _config("kinematic", catch_rule="held_stick"),
+        "second": _config("kinematic", arm_dynamics="servo"),
+        "both": _config("kinematic", catch_rule="held_stick", arm_dynamics="servo"),
+    }
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    page = factorial_files(_read(_values(), configs), cells, ("a", "b"), "cmd")["factorial.md"]
+    table = page.decode().split("## Each rule")[0]
+    rows = {line.split(" | ")[0][2:]: line for line in table.splitlines()}
+    assert "| rung | batch | changes from neither |" in table
+    assert "catch_rule: study -> held_stick" in rows["both"]
+    assert "arm_dynamics: set -> servo" in rows["both"]
+    assert "catch_rule" not in rows["second"]
