@@ -14,7 +14,7 @@ from trial_recompute import check_factorial_page, study_headline
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 # Each published factorial (`make contact-factorial`): its page and the per-trial data beside it.
-DESIGNS = ("held-pose-pushing", "catch-distance")
+DESIGNS = ("held-pose-pushing", "catch-servo", "catch-distance")
 
 
 @pytest.mark.parametrize("design", DESIGNS)
