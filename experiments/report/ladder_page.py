@@ -42,12 +42,16 @@ def _rows(table: pd.DataFrame, where: dict | None = None, **also: str) -> list[d
 
 
 def rungs_table(
-    rungs: list[ladder.Rung], beside: list[ladder.Rung], own: dict[str, BatchResults]
+    rungs: list[ladder.Rung],
+    beside: list[ladder.Rung],
+    own: dict[str, BatchResults],
+    against_first: bool = False,
 ) -> list[str]:
     """One row per rung: its batch, everything it changes from the rung before (a rung beside
-    the ladder: from the last rung) (rung_change.describe), its trials and where they were
-    computed."""
-    head = "| rung | batch | changes from the rung before | trials (seeds) | computed on |"
+    the ladder: from the last rung; `against_first`, a factorial's cells, which have no order:
+    from the first) (rung_change.describe), its trials and where they were computed."""
+    against = f"changes from {rungs[0].name}" if against_first else "changes from the rung before"
+    head = f"| rung | batch | {against} | trials (seeds) | computed on |"
     lines = [head, "|---|---|---|---|---|"]
     before = None
     last = None
@@ -65,7 +69,8 @@ def rungs_table(
             f"| {rung.name} | {rung.batch_dir.name} ({group}) | {change} | "
             f"{len(seeds)} ({seeds_text(seeds)}) | {machines_text(results)} |"
         )
-        before = world
+        if before is None or not against_first:
+            before = world
         if rung == rungs[-1]:
             last = world
     return lines
@@ -173,8 +178,15 @@ def _seeds_or_none(seeds: list[int]) -> str:
     return seeds_text(seeds) if seeds else "none"
 
 
-def completeness_lines(check: pd.DataFrame) -> list[str]:
-    """The completeness check (ladder.completeness) and its verdict."""
+# What the seeds some rungs hold beyond the common ones enter, on a ladder's page.
+LADDER_OTHER_SEEDS = (
+    "Every step is taken on the seeds every rung holds; the others enter only comparisons of "
+    "rungs that both hold them (the whole on every seed of the first and last rungs)."
+)
+
+
+def completeness_lines(check: pd.DataFrame, other_seeds: str = LADDER_OTHER_SEEDS) -> list[str]:
+    """The completeness check (ladder.completeness) and its verdict (`completeness_verdict`)."""
     worlds = [ladder.OWN, *ladder.WORLDS]
     head = ["rung", "seeds", *(f"seeds lacking ({w})" for w in worlds), "values not finite"]
     lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
@@ -183,12 +195,6 @@ def completeness_lines(check: pd.DataFrame) -> list[str]:
         lines.append(
             f"| {r['rung']} | {r['seeds']} | " + " | ".join(missing) + f" | {r['not_finite']} |"
         )
-    verdict = (
-        "Complete: every rung holds every seed in its own world and in both test worlds."
-        if check["complete"].all()
-        else "Incomplete: the steps are taken on the seeds every rung holds; the rows above "
-        "say what each rung lacks."
-    )
     return [
         "What it checks: that every rung (and every rung beside the ladder) holds every seed "
         "any rung holds, in its own world and in each test world; a value that is not finite "
@@ -197,8 +203,34 @@ def completeness_lines(check: pd.DataFrame) -> list[str]:
         "",
         *lines,
         "",
-        verdict,
+        completeness_verdict(check, other_seeds),
     ]
+
+
+def completeness_verdict(check: pd.DataFrame, other_seeds: str = LADDER_OTHER_SEEDS) -> str:
+    """The verdict: complete; or, where the rungs merely hold different seeds (each trial tested
+    in every world, as designed when the ends hold more seeds), which rungs lack which seeds
+    and `other_seeds`, what the page does with the seeds not every rung holds; or incomplete,
+    naming each rung whose trials lack a test world (a cross-evaluation missing)."""
+    if check["complete"].all():
+        return "Complete: every rung holds every seed in its own world and in both test worlds."
+    untested = []
+    for r in check.to_dict("records"):
+        worlds = [w for w in ladder.WORLDS if r[f"missing_{w}"] != r["missing_own"]]
+        if worlds:
+            untested.append(f"{r['rung']} ({', '.join(worlds)})")
+    if untested:
+        return (
+            "Incomplete: some trials were not tested in every world: "
+            + "; ".join(untested)
+            + ". The steps are taken on the seeds every rung holds in each world."
+        )
+    lacking = set().union(*check["missing_own"])
+    fewer = ", ".join(r["rung"] for r in check.to_dict("records") if r["missing_own"])
+    return (
+        f"Every trial was tested in both test worlds. The rungs hold different seeds: {fewer} "
+        f"lack {seeds_text(sorted(lacking))}. {other_seeds}"
+    )
 
 
 def markdown(

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from test_ladder import KEY, _config, _read
+from trial_recompute import check_factorial_page
 
 from experiments.cli.main import main
 from experiments.report import ladder
@@ -68,3 +69,61 @@ def test_a_design_of_other_than_four_cells_is_refused_in_one_line(batches, tmp_p
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "a 2 x 2 design has 4 cells" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_cells_holding_more_seeds_than_others_are_said_so_and_enter_no_contrast():
+    """The real designs cross 16-seed cells with 32-seed rungs and the comparison's 64: every
+    contrast is on the seeds all four hold, and the page says so (not "Incomplete", and not
+    the ladder's whole on every seed, which a factorial does not compute)."""
+    values = _values()
+    values = pd.concat([values.assign(tested=t) for t in ("own", *ladder.WORLDS)])
+    values = values[(values["rung"] != "first") | (values["seed"] < 4)]
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    files = factorial_files(
+        _read(values, {c: _config("kinematic") for c in CELLS}), cells, ("a", "b"), "cmd"
+    )
+    tests = pd.read_csv(io.BytesIO(files["factorial.csv"]))
+    assert set(tests["n"]) == {4}
+    page = files["factorial.md"].decode()
+    assert "first lack 4–7. Every contrast is taken on the seeds every cell holds" in page
+    assert "Incomplete" not in page and "the whole" not in page.split("## Completeness")[1]
+
+
+def test_every_cell_of_the_page_is_computed_again_from_its_per_trial_data_alone():
+    """factorial-trials.csv holds all a reader needs: each contrast's mean, interval, t and
+    signed-rank p, the Holm stars and counts, and each cell's mean, computed again with scipy
+    (trial_recompute.check_factorial_page, which also checks the published pages)."""
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    read = _read(_values(), {c: _config("kinematic") for c in CELLS})
+    named = " ".join(f"{c}={c}" for c in CELLS)
+    command = f'playroom factorial {named} --factors "catch rule" "servo arm" --out x'
+    files = factorial_files(read, cells, ("catch rule", "servo arm"), command)
+    page = files["factorial.md"].decode()
+    trials = pd.read_csv(io.BytesIO(files["factorial-trials.csv"]))
+    check_factorial_page(page, trials, read.measures)
+    # Another trial's value, or a cell of the table written by hand, fails the check.
+    moved = trials[KEY].where(trials["rung"] != "both", trials[KEY] + 0.01)
+    with pytest.raises(AssertionError):
+        check_factorial_page(page, trials.assign(**{KEY: moved}), read.measures)
+    mean = f"{100 * trials.loc[trials['rung'] == 'neither', KEY].mean():.1f}"
+    with pytest.raises(AssertionError):
+        check_factorial_page(page.replace(f"| {mean} |", "| 0.0 |", 1), trials, read.measures)
+
+
+def test_each_cell_says_what_it_changes_from_the_cell_of_neither_rule():
+    """A factorial's cells have no order: the page lists what each changes from the first
+    cell (neither rule), so that the cell of both names both rules."""
+    configs = {
+        "neither": _config("kinematic"),
+        "first": _config("kinematic", catch_rule="held_stick"),
+        "second": _config("kinematic", arm_dynamics="servo"),
+        "both": _config("kinematic", catch_rule="held_stick", arm_dynamics="servo"),
+    }
+    cells = [ladder.Rung(c, Path(c)) for c in CELLS]
+    page = factorial_files(_read(_values(), configs), cells, ("a", "b"), "cmd")["factorial.md"]
+    table = page.decode().split("## Each rule")[0]
+    rows = {line.split(" | ")[0][2:]: line for line in table.splitlines()}
+    assert "| rung | batch | changes from neither |" in table
+    assert "catch_rule: study -> held_stick" in rows["both"]
+    assert "arm_dynamics: set -> servo" in rows["both"]
+    assert "catch_rule" not in rows["second"]

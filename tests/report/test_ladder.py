@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from trial_batches import batch
+from trial_recompute import ladder_case
 
 from experiments.analysis import step_split
 from experiments.analysis.trial_tests import holm
@@ -339,35 +340,6 @@ def test_one_order_is_worded_as_each_rule_given_the_rules_before_it():
     assert "given the rules before it" in figure.get_suptitle()
 
 
-def _recomputed(trials: pd.DataFrame, case: dict, seeds: set[int]) -> dict:
-    """A test of the page computed from the per-trial data alone, with scipy: B minus A on the
-    given seeds, pairs with an empty cell left out."""
-    from scipy import stats
-
-    def values(rung: str, tested: str) -> pd.Series:
-        mine = trials[(trials["rung"] == rung) & (trials["tested"] == tested)]
-        return mine.set_index("seed")[case["key"]].loc[lambda v: v.index.isin(seeds)]
-
-    a, b = case["from"], case["to"]
-    if case["part"] == "step":
-        diff = values(b, "own") - values(a, "own")
-    elif case["part"] == "both_in_world":
-        diff = values(b, case["world"]) - values(a, case["world"])
-    else:
-        w = case["world"]
-        diff = (values(b, "own") - values(b, w)) - (values(a, "own") - values(a, w))
-    d = diff.dropna().to_numpy()
-    half = stats.t.ppf(0.975, len(d) - 1) * stats.sem(d)
-    return {
-        "mean": d.mean(),
-        "low": d.mean() - half,
-        "high": d.mean() + half,
-        "p": stats.ttest_1samp(d, 0.0).pvalue,
-        "p_rank": stats.wilcoxon(d, zero_method="pratt").pvalue,
-        "n": len(d),
-    }
-
-
 def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alone():
     """ladder-trials.csv, the data published beside the page, holds all a reader needs: each
     test's mean, interval, t and signed-rank p, and each rung's mean, computed from it with
@@ -389,7 +361,7 @@ def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alon
     assert {r["kind"] for r in made} == {"step", "whole", "whole_all", "beside"}
     for case in made:
         seeds = ladder_seeds if case["kind"] in ("step", "whole") else every
-        again = _recomputed(trials, case, seeds)
+        again = ladder_case(trials, case, seeds)
         for column, value in again.items():
             assert case[column] == pytest.approx(value, rel=1e-9), (case, column)
         if case["part"] == "step":
@@ -397,3 +369,17 @@ def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alon
     # The rungs' means the page shows: over the seeds every rung holds.
     mean_a = own[(own["rung"] == "A") & own["seed"].isin(ladder_seeds)][KEY].mean()
     assert f"| ring 1 | {100 * mean_a:.1f} |" in page
+
+
+def test_the_verdict_tells_rungs_holding_other_seeds_from_trials_missing_a_test_world():
+    """Ends holding more seeds than the middle rungs, every trial tested in both worlds: the
+    page says which seeds the steps use, not "Incomplete"; a trial missing a test world is."""
+    from experiments.report.ladder_page import completeness_verdict
+
+    values = _values(LEVELS, drop=("B", 3))
+    verdict = completeness_verdict(ladder.completeness(values, ["A", "B", "C"]))
+    assert "Incomplete" not in verdict
+    assert "B lack 3" in verdict and "Every step is taken on the seeds every rung holds" in verdict
+    untested = values[~((values["rung"] == "C") & (values["tested"] == "physical"))]
+    verdict = completeness_verdict(ladder.completeness(untested, ["A", "B", "C"]))
+    assert verdict.startswith("Incomplete") and "C (physical)" in verdict

@@ -1,10 +1,12 @@
-"""A comparison page's tests computed again from its per-trial data alone (comparison-trials.csv),
-with scipy, as a reader would: for tests/report/test_comparison_data.py and the real page's
-test in tests/report/test_report.py."""
+"""A page's tests computed again from its per-trial data alone, with scipy, as a reader would: a
+comparison page's (comparison-trials.csv: tests/report/test_comparison_data.py, test_report.py,
+test_comparison_doc_data.py) and the contact ladder's (ladder-trials.csv: test_ladder.py,
+test_ladder_doc_data.py)."""
 
 from __future__ import annotations
 
 import math
+import shlex
 import warnings
 from pathlib import Path
 
@@ -91,3 +93,104 @@ def check_trials_file(out: Path, page: str, tests: list[dict]) -> pd.DataFrame:
     assert trials["evaluated_on"].ne("not recorded").all()
     check_tests_again(trials, tests)
     return trials
+
+
+def ladder_case(trials: pd.DataFrame, case: dict, seeds: set[int]) -> dict[str, float]:
+    """One test of the ladder's family (`case`: key, from, to, part, world) from its per-trial
+    table (a row per rung, world tested in and seed): B minus A on the given seeds, the step in
+    the rungs' own worlds or a part of its split in `world`, pairs with an empty cell left out.
+    Its mean, 95% t interval, t p and signed-rank p (NaN where every pair is equal), pairs."""
+
+    def values(rung: str, tested: str) -> pd.Series:
+        mine = trials[(trials["rung"] == rung) & (trials["tested"] == tested)]
+        return mine.set_index("seed")[case["key"]].loc[lambda v: v.index.isin(seeds)]
+
+    a, b, world = case["from"], case["to"], case.get("world")
+    if case["part"] == "step":
+        diff = values(b, "own") - values(a, "own")
+    elif case["part"] == "both_in_world":
+        diff = values(b, world) - values(a, world)
+    else:
+        diff = (values(b, "own") - values(b, world)) - (values(a, "own") - values(a, world))
+    return _paired_against_zero(diff)
+
+
+def _paired_against_zero(diff: pd.Series) -> dict[str, float]:
+    """Per-seed differences (an empty or infinite one left out) against zero: mean, 95% t
+    interval, t p, signed-rank p (NaN where every pair is equal), pairs."""
+    d = diff.dropna().to_numpy()
+    d = d[np.isfinite(d)]
+    if len(d) < 2 or np.all(d == d[0]):
+        mean = d.mean() if len(d) else math.nan
+        return {
+            "mean": mean,
+            "low": mean,
+            "high": mean,
+            "p": math.nan,
+            "p_rank": math.nan,
+            "n": len(d),
+        }
+    half = stats.t.ppf(0.975, len(d) - 1) * stats.sem(d)
+    return {
+        "mean": d.mean(),
+        "low": d.mean() - half,
+        "high": d.mean() + half,
+        "p": stats.ttest_1samp(d, 0.0).pvalue,
+        "p_rank": stats.wilcoxon(d, zero_method="pratt").pvalue,
+        "n": len(d),
+    }
+
+
+def check_factorial_page(page: str, trials: pd.DataFrame, measures: list) -> None:
+    """A factorial page (`playroom factorial`'s factorial.md) against its per-trial data
+    (factorial-trials.csv) alone: the cells named by its command, each contrast of each measure
+    (`measures`: the ladder's headline) per seed on the seeds all four cells hold, computed with
+    scipy, Holm over the family for each kind of p, and every cell of its table written from
+    those numbers; the family's counts as the page states them."""
+    from experiments.analysis.trial_tests import survives
+    from experiments.report.factorial import CONTRASTS
+    from experiments.report.paired_text import cell_text, level_text
+
+    command = page.split("Written by `", 1)[1].split("`", 1)[0]
+    words = shlex.split(command)
+    cells = [w.split("=")[0] for w in words[: words.index("--factors")] if "=" in w]
+    own = trials[trials["tested"] == "own"]
+    seeds = set.intersection(*(set(own.loc[own["rung"] == c, "seed"]) for c in cells))
+    own = own[own["seed"].isin(seeds)]
+    rows = []
+    for h in measures:
+        table = own.pivot(index="seed", columns="rung", values=h.key)
+        for name, w in CONTRASTS.items():
+            weights = {c: x for c, x in zip(cells, w, strict=True) if x}
+            rows.append(
+                {"key": h.key, "contrast": name}
+                | _paired_against_zero(sum(table[c] * x for c, x in weights.items()))
+            )
+    tests = pd.DataFrame(rows)
+    tests["p_holm"] = holm(list(tests["p"]))
+    tests["p_rank_holm"] = holm(list(tests["p_rank"]))
+    lines = {line.split(" | ")[0][2:]: line for line in page.splitlines() if line.startswith("| ")}
+    for h in measures:
+        cells_text = [c.strip() for c in lines[h.label].strip("|").split(" | ")][1:]
+        mine = tests[tests["key"] == h.key].to_dict("records")
+        means = [level_text(h.measure.kind, own.loc[own["rung"] == c, h.key].mean()) for c in cells]
+        assert cells_text == means + [cell_text(h.measure.kind, r) for r in mine], h.label
+    made = tests[np.isfinite(tests["p"])]
+    t = int(sum(survives(p) for p in made["p_holm"]))
+    rank = int(sum(survives(p) for p in made["p_rank_holm"]))
+    assert f"One family of {len(tests)} tests" in page and f"; {len(made)} could be made." in page
+    assert f"{t} survive with the paired t, {rank} with the signed-rank test." in page
+
+
+def study_headline() -> list:
+    """The ladder's and factorial's headline measures (labels and kinds) for the study preset's
+    world and voice, as the published pages name them."""
+    from experiments.analysis.geometry import Geometry
+    from experiments.report import ladder
+    from sim.config import world_preset
+    from sim.vocal.config import VoiceConfig
+
+    world, voice = world_preset("study"), VoiceConfig()
+    hand = float(sum(world.segment_lengths))
+    geometry = Geometry(hand, hand + world.stick_length, voice.recognition_distance, 0)
+    return ladder.headline(geometry)
