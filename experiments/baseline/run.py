@@ -144,7 +144,7 @@ def run_baseline(
             for toy, n in steps.items():
                 if str(toy) in toys:
                     continue
-                env = _env(record, settings, toy, room)
+                env = _env(record, toy, room)
                 seed = settings.toy_seed(toy)
                 data, entry = training.train_policy(env, n, seed, settings.torch_threads, bar)
                 entry["seed"] = seed
@@ -166,10 +166,11 @@ def run_baseline(
     return summary
 
 
-def _env(record: dict, settings: BaselineSettings, toy: int, room: Any) -> training.SameWords:
-    """Toy `toy`'s goal environment in the trial's world, with the words of its room."""
+def _env(record: dict, toy: int, room: Any) -> training.SameWords:
+    """Toy `toy`'s goal environment in the trial's room: its backend, world and words, and the
+    voice baseline.json records."""
     voice = config_from_dict(VoiceConfig, record["trial"]["voice"])
-    return training.make_env(settings.grasp, toy, room.config, voice, room.words)
+    return training.make_env(room.grasp, toy, room.config, voice, room.words)
 
 
 def evaluate_baseline(
@@ -185,7 +186,7 @@ def evaluate_baseline(
     actor = PolicyActor(
         {
             int(t): training.load_policy(
-                (out / policy_file(int(t))).read_bytes(), _env(record, settings, int(t), room)
+                (out / policy_file(int(t))).read_bytes(), _env(record, int(t), room)
             )
             for t in toys
         }

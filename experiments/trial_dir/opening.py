@@ -133,9 +133,16 @@ def _opened(
         held = storage.read_json(config_path)
         _check_same_configuration(config_path, held, config)
     identity, source = trial_identity(config), source_of(d, config)
+    # A resumed trial's files are checked against the record they lie beside, which the run's
+    # config was just checked against: the resume needs the directory alone, not the run.
+    own = None if held is None else (trial_identity(held), source_of(d, held))
     _ready_to_write(d, config, held is None)
     notices: list[str] = []
-    restored = prepare_resume(d, identity, source, parts, build, notices) if resume else None
+    restored = None
+    if own is not None:
+        restored = prepare_resume(d, *own, parts, build, notices)
+    elif resume:
+        notices.append(f"{d} holds no checkpoint yet: starting it from iteration 0")
     if restored is None:
         agent, room = parts
         unreached = np.full(words, np.inf)

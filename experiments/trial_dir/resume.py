@@ -51,16 +51,16 @@ def prepare_resume(
     notices: list[str],
 ) -> Resumed[A, R] | None:
     """What a resume starts from: the newest usable checkpoint of the trial of `identity`
-    (config_file.trial_identity), restored into `parts` (fresh ones `build` builds where a
-    restore fails half-way), whose logs are whole and as recorded, or None to start from
-    iteration 0 (no checkpoint and no logs yet). The trial's chunks are listed once, after the
-    checkpoint is restored, and everything is checked before anything is changed; then a
-    damaged newest checkpoint is kept as checkpoint.damaged.npz, the litter of killed writers
-    removed, old logs moved into their folders (their rows given the trial's `source` columns,
-    config_file.source_of) and the work past the checkpoint (log chunks, memory segments,
-    manifest files) dropped: the run writes it again. Appends to `notices` one line per thing
-    done or noticed. TrialError if the trial cannot be resumed (the message says why and what
-    can be done)."""
+    (config_file.trial_identity of the config.json it lies beside), restored into `parts`
+    (fresh ones `build` builds where a restore fails half-way), whose logs are whole and as
+    recorded, or None to start from iteration 0 (no checkpoint and no logs yet). The trial's
+    chunks are listed once, after the checkpoint is restored, and everything is checked before
+    anything is changed; then a damaged newest checkpoint is kept as checkpoint.damaged.npz,
+    the litter of killed writers removed, old logs moved into their folders (their rows given
+    the trial's `source` columns, config_file.source_of) and the work past the checkpoint (log
+    chunks, memory segments, manifest files) dropped: the run writes it again. Appends to
+    `notices` one line per thing done or noticed. TrialError if the trial cannot be resumed
+    (the message says why and what can be done)."""
     newest = trial_dir / CHECKPOINT_FILE
     checkpointed = newest.exists() or (trial_dir / PREVIOUS_CHECKPOINT_FILE).exists()
     newest_usable = restore_newest(trial_dir, identity, parts, build) if checkpointed else None
