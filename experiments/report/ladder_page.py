@@ -225,11 +225,18 @@ def completeness_verdict(check: pd.DataFrame, other_seeds: str = LADDER_OTHER_SE
             + "; ".join(untested)
             + ". The steps are taken on the seeds every rung holds in each world."
         )
-    lacking = set().union(*check["missing_own"])
-    fewer = ", ".join(r["rung"] for r in check.to_dict("records") if r["missing_own"])
+    # Rungs lacking the same seeds named together: "a, b lack 32–63; c lacks 16–63".
+    by_lacking: dict[tuple[int, ...], list[str]] = {}
+    for r in check.to_dict("records"):
+        if r["missing_own"]:
+            by_lacking.setdefault(tuple(r["missing_own"]), []).append(r["rung"])
+    lacks = "; ".join(
+        f"{', '.join(names)} {'lacks' if len(names) == 1 else 'lack'} {seeds_text(list(seeds))}"
+        for seeds, names in by_lacking.items()
+    )
     return (
-        f"Every trial was tested in both test worlds. The rungs hold different seeds: {fewer} "
-        f"lack {seeds_text(sorted(lacking))}. {other_seeds}"
+        "Every trial was tested in both test worlds. The rungs hold different seeds: "
+        f"{lacks}. {other_seeds}"
     )
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from trial_recompute import recomputed
+from trial_recompute import page_table, recomputed
 
 from experiments.report.pages import p_value
 
@@ -31,14 +31,8 @@ ROWS = {
 
 def _table_rows(text: str) -> dict[str, list[str]]:
     """The cells of the first table of differences, by measure."""
-    start = text.index("| measure (mean over trials [95% t interval]) | kinematic | physical |")
-    rows = {}
-    for line in text[start:].splitlines()[2:]:
-        if not line.startswith("|"):
-            break
-        cells = [c.strip() for c in line.strip("|").split(" | ")]
-        rows[cells[0]] = cells
-    return rows
+    head = "| measure (mean over trials [95% t interval]) | kinematic | physical |"
+    return {row[0]: row for row in page_table(text, head)}
 
 
 @pytest.fixture(scope="module")

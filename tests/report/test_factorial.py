@@ -78,6 +78,7 @@ def test_cells_holding_more_seeds_than_others_are_said_so_and_enter_no_contrast(
     values = _values()
     values = pd.concat([values.assign(tested=t) for t in ("own", *ladder.WORLDS)])
     values = values[(values["rung"] != "first") | (values["seed"] < 4)]
+    values = values[(values["rung"] != "second") | (values["seed"] < 6)]
     cells = [ladder.Rung(c, Path(c)) for c in CELLS]
     files = factorial_files(
         _read(values, {c: _config("kinematic") for c in CELLS}), cells, ("a", "b"), "cmd"
@@ -85,7 +86,8 @@ def test_cells_holding_more_seeds_than_others_are_said_so_and_enter_no_contrast(
     tests = pd.read_csv(io.BytesIO(files["factorial.csv"]))
     assert set(tests["n"]) == {4}
     page = files["factorial.md"].decode()
-    assert "first lack 4–7. Every contrast is taken on the seeds every cell holds" in page
+    # Each cell named with the seeds it lacks, not the union of all (it lacks only its own).
+    assert "first lacks 4–7; second lacks 6, 7. Every contrast is taken on the seeds" in page
     assert "Incomplete" not in page and "the whole" not in page.split("## Completeness")[1]
 
 

@@ -379,7 +379,7 @@ def test_the_verdict_tells_rungs_holding_other_seeds_from_trials_missing_a_test_
     values = _values(LEVELS, drop=("B", 3))
     verdict = completeness_verdict(ladder.completeness(values, ["A", "B", "C"]))
     assert "Incomplete" not in verdict
-    assert "B lack 3" in verdict and "Every step is taken on the seeds every rung holds" in verdict
+    assert "B lacks 3" in verdict and "Every step is taken on the seeds every rung holds" in verdict
     untested = values[~((values["rung"] == "C") & (values["tested"] == "physical"))]
     verdict = completeness_verdict(ladder.completeness(untested, ["A", "B", "C"]))
     assert verdict.startswith("Incomplete") and "C (physical)" in verdict

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from trial_recompute import ladder_case, study_headline
+from trial_recompute import ladder_case, page_table, study_headline
 
 from experiments.analysis.trial_tests import holm, survives
 from experiments.report import ladder
@@ -34,18 +34,6 @@ def _rungs(text: str) -> tuple[list[str], list[str]]:
     return [w.split("=")[0] for w in words[:cut] if "=" in w], [
         w.split("=")[0] for w in words[cut:] if "=" in w
     ]
-
-
-def _tables(text: str, head: str) -> dict[str, list[str]]:
-    """The table starting with the line `head`: cells by the row's first cell."""
-    start = text.index(head)
-    rows = {}
-    for line in text[start:].splitlines()[2:]:
-        if not line.startswith("|"):
-            break
-        cells = [c.strip() for c in line.strip("|").split(" | ")]
-        rows[cells[0]] = cells
-    return rows
 
 
 @pytest.fixture(scope="module", params=PAGES)
@@ -80,7 +68,7 @@ def test_the_published_trials_hold_every_rung_in_every_world(page):
 
 def test_every_step_cell_is_computed_again_from_the_published_trials(page):
     text, trials, order, beside, measures, common, tests = page
-    rows = _tables(text, f"| measure | {order[0]} (mean) |")
+    rows = {r[0]: r for r in page_table(text, f"| measure | {order[0]} (mean) |")}
     steps = tests[tests["part"] == "step"]
     own = trials[(trials["tested"] == ladder.OWN) & trials["seed"].isin(common)]
     for h in measures:
@@ -95,13 +83,8 @@ def test_every_step_cell_is_computed_again_from_the_published_trials(page):
 
 def test_every_split_cell_is_computed_again_from_the_published_trials(page):
     text, _, _, _, _, _, tests = page
-    rows = {}
-    start = text.index("| step | part | all | ring1 | ring2 | ring3 |")
-    for line in text[start:].splitlines()[2:]:
-        if not line.startswith("|"):
-            break
-        cells = [c.strip() for c in line.strip("|").split(" | ")]
-        rows[(cells[0], cells[1].split(" (")[0])] = cells[2:]
+    head = "| step | part | all | ring1 | ring2 | ring3 |"
+    rows = {(r[0], r[1].split(" (")[0]): r[2:] for r in page_table(text, head)}
     splits = tests[tests["part"] != "step"]
     assert len(rows) == len(splits) // len(ladder.COMPETENCE)
     for (a, b, kind, world, part), cases in splits.groupby(

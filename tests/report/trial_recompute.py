@@ -194,3 +194,13 @@ def study_headline() -> list:
     hand = float(sum(world.segment_lengths))
     geometry = Geometry(hand, hand + world.stick_length, voice.recognition_distance, 0)
     return ladder.headline(geometry)
+
+
+def page_table(text: str, head: str) -> list[list[str]]:
+    """The cells of each row of the markdown table whose header line starts with `head`."""
+    rows = []
+    for line in text[text.index(head) :].splitlines()[2:]:
+        if not line.startswith("|"):
+            break
+        rows.append([c.strip() for c in line.strip("|").split(" | ")])
+    return rows
