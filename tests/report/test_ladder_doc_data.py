@@ -24,6 +24,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs"
 PAGES = {
     "contact-ladder.md": "contact-ladder-trials.csv",
     "contact-unbundled.md": "contact-unbundled-trials.csv",
+    "held-pose-returns.md": "held-pose-returns-trials.csv",
 }
 
 
