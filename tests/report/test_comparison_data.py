@@ -136,7 +136,6 @@ def test_every_test_is_computed_again_from_the_per_trial_data_alone(seeds_b):
     assert competence[2].startswith(pct(means["physical"], 1) + " [")
 
 
-
 @pytest.mark.parametrize("commit", ["6163356", "1234e56", "0123456"])
 def test_commits_of_digits_alone_read_back_as_the_commits_they_are(commit):
     """A short commit can be all digits, or digits around one 'e': read back from a per-trial
