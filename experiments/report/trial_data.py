@@ -15,7 +15,9 @@ hand, tool and vocal).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
+from typing import IO
 
 import pandas as pd
 
@@ -61,6 +63,13 @@ def who_computed(results: BatchResults) -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows, columns=["trial", "seed", *WHO])
+
+
+def read_trial_data(source: str | os.PathLike | IO) -> pd.DataFrame:
+    """A per-trial data file read back, the columns of who computed each trial (`WHO`) and the
+    trial's name as text: a commit of digits alone ("6163356", or "1234e56") would otherwise be
+    read as a number, and lose its leading zeros or its letters."""
+    return pd.read_csv(source, dtype=dict.fromkeys(["trial", *WHO], str))
 
 
 def column_name(measure: Measure, part: str) -> str:

@@ -23,6 +23,7 @@ from experiments.measure.evaluation import EvaluationSettings
 from experiments.measure.for_reports import room_measures
 from experiments.measure.trial_evaluation import evaluate_trial
 from experiments.report.ablations import ablation_rows, write_ablations
+from experiments.report.trial_data import read_trial_data
 from experiments.run.settings import TrialSettings
 from experiments.run.trial import run_trial
 from experiments.trial_dir.config_file import config_differences
@@ -135,7 +136,7 @@ def test_files_are_written_with_every_row(batches, sigma_batch, tmp_path):
     assert "Mann-Whitney two-sided p, one-sided doubled as the study" in lines[0]
     assert (tmp_path / "out" / ABLATION_FIGURE_FILE).read_bytes().startswith(b"\x89PNG")
     # Every trial of every row, with who computed it (the trials' provenance.json, eval.json).
-    trials = pd.read_csv(tmp_path / "out" / "ablations-trials.csv")
+    trials = read_trial_data(tmp_path / "out" / "ablations-trials.csv")
     assert list(zip(trials["batch"], trials["seed"], strict=True)) == [
         ("kinematic", 0),
         ("kinematic", 1),

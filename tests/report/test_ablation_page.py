@@ -19,6 +19,7 @@ from trial_batches import batch
 from experiments.analysis.trial_tests import holm
 from experiments.measure.for_reports import room_measures
 from experiments.report.ablations import ablation_files
+from experiments.report.trial_data import read_trial_data
 from experiments.run.settings import TrialSettings
 from experiments.run.trial_config import full_config
 
@@ -106,7 +107,7 @@ def test_every_number_of_the_table_is_computed_again_from_its_per_trial_data_alo
     """ablations-trials.csv holds all a reader needs: each row's means, its paired differences
     from the baseline with their interval, t and signed-rank p, the gap against 0 with both
     ps, and their Holm adjustments, computed from it with scipy are ablations.csv's."""
-    trials = pd.read_csv(io.BytesIO(files["ablations-trials.csv"]))
+    trials = read_trial_data(io.BytesIO(files["ablations-trials.csv"]))
     numbers = pd.read_csv(io.BytesIO(files["ablations.csv"]))
     assert {"row", "baseline", "batch", "group", "seed", "trial", "grasp"} <= set(trials)
     assert {"computed_on", "computed_commit", "evaluated_on", "evaluated_commit"} <= set(trials)

@@ -10,7 +10,6 @@ from __future__ import annotations
 import io
 
 import numpy as np
-import pandas as pd
 import pytest
 from scipy import stats
 from trial_batches import GEOMETRY, batch
@@ -21,6 +20,7 @@ from experiments.report.comparison import disagreement_lines
 from experiments.report.comparison import tests_note as note_on_tests
 from experiments.report.measures import registry
 from experiments.report.pages import p_value, pct
+from experiments.report.trial_data import read_trial_data
 
 SEEDS = list(range(8))
 COMPETENCE = np.array([0.10, 0.25, 0.18, 0.30, 0.05, 0.22, 0.15, 0.28])
@@ -115,7 +115,7 @@ def test_every_test_is_computed_again_from_the_per_trial_data_alone(seeds_b):
     a, b = _sides(seeds_b)
     evaluated = _evaluate(a, b)
     table = comparison_data.trial_table(evaluated, a, b)
-    trials = pd.read_csv(io.BytesIO(table.to_csv(index=False).encode()))
+    trials = read_trial_data(io.BytesIO(table.to_csv(index=False).encode()))
     assert list(trials.columns[:5]) == ["batch", "group", "seed", "trial", "grasp"]
     assert list(trials.columns[-4:]) == [
         "computed_on",
@@ -134,3 +134,16 @@ def test_every_test_is_computed_again_from_the_per_trial_data_alone(seeds_b):
     means = trials.groupby("group")["competence_all"].mean()
     assert competence[1].startswith(pct(means["kinematic"], 1) + " [")
     assert competence[2].startswith(pct(means["physical"], 1) + " [")
+
+
+@pytest.mark.parametrize("commit", ["6163356", "1234e56", "0123456"])
+def test_commits_of_digits_alone_read_back_as_the_commits_they_are(commit):
+    """A short commit can be all digits, or digits around one 'e': read back from a per-trial
+    data file whose trials one such commit computed, it stays the text it was, not a number
+    (the bug commit 6163356 showed)."""
+    a, b = _sides(SEEDS)
+    table = comparison_data.trial_table(_evaluate(a, b), a, b)
+    table["computed_commit"] = table["evaluated_commit"] = commit
+    trials = read_trial_data(io.BytesIO(table.to_csv(index=False).encode()))
+    assert trials["computed_commit"].eq(commit).all()
+    assert trials["evaluated_commit"].eq(commit).all()

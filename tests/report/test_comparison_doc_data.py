@@ -14,6 +14,7 @@ import pytest
 from trial_recompute import page_table, recomputed
 
 from experiments.report.pages import p_value
+from experiments.report.trial_data import read_trial_data
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 GROUPS = ("kinematic", "physical")
@@ -37,7 +38,7 @@ def _table_rows(text: str) -> dict[str, list[str]]:
 
 @pytest.fixture(scope="module")
 def published() -> tuple[pd.DataFrame, dict[str, list[str]]]:
-    trials = pd.read_csv(DOCS / "data" / "comparison-diva-trials.csv")
+    trials = read_trial_data(DOCS / "data" / "comparison-diva-trials.csv")
     return trials, _table_rows((DOCS / "comparison.md").read_text())
 
 

@@ -15,6 +15,7 @@ from trial_recompute import check_factorial_page
 from experiments.cli.main import main
 from experiments.report import ladder
 from experiments.report.factorial import CONTRASTS, factorial_files
+from experiments.report.trial_data import read_trial_data
 
 SEEDS = range(8)
 CELLS = ("neither", "first", "second", "both")
@@ -56,7 +57,7 @@ def test_each_rule_with_the_other_off_and_on_its_main_effect_and_the_interaction
     page = files["factorial.md"].decode()
     assert "| catch rule, servo arm off | catch rule, servo arm on |" in page
     # The contrasts again from the per-trial data alone.
-    trials = pd.read_csv(io.BytesIO(files["factorial-trials.csv"])).pivot(
+    trials = read_trial_data(io.BytesIO(files["factorial-trials.csv"])).pivot(
         index="seed", columns="rung", values=KEY
     )
     again = (trials["both"] - trials["second"]) - (trials["first"] - trials["neither"])
@@ -101,7 +102,7 @@ def test_every_cell_of_the_page_is_computed_again_from_its_per_trial_data_alone(
     command = f'playroom factorial {named} --factors "catch rule" "servo arm" --out x'
     files = factorial_files(read, cells, ("catch rule", "servo arm"), command)
     page = files["factorial.md"].decode()
-    trials = pd.read_csv(io.BytesIO(files["factorial-trials.csv"]))
+    trials = read_trial_data(io.BytesIO(files["factorial-trials.csv"]))
     check_factorial_page(page, trials, read.measures)
     # Another trial's value, or a cell of the table written by hand, fails the check.
     moved = trials[KEY].where(trials["rung"] != "both", trials[KEY] + 0.01)

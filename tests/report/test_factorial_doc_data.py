@@ -8,9 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pandas as pd
 import pytest
 from trial_recompute import check_factorial_page, study_headline
+
+from experiments.report.trial_data import read_trial_data
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 # Each published factorial (`make contact-factorial`): its page and the per-trial data beside it.
@@ -20,6 +21,6 @@ DESIGNS = ("held-pose-pushing", "catch-servo", "catch-distance")
 @pytest.mark.parametrize("design", DESIGNS)
 def test_every_cell_of_a_published_factorial_is_computed_again(design):
     page = (DOCS / f"contact-factorial-{design}.md").read_text()
-    trials = pd.read_csv(DOCS / "data" / f"contact-factorial-{design}-trials.csv")
+    trials = read_trial_data(DOCS / "data" / f"contact-factorial-{design}-trials.csv")
     assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}").all()
     check_factorial_page(page, trials, study_headline())

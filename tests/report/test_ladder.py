@@ -19,6 +19,7 @@ from experiments.analysis import step_split
 from experiments.analysis.trial_tests import holm
 from experiments.cli.main import main
 from experiments.report import ladder, ladder_data
+from experiments.report.trial_data import read_trial_data
 
 SEEDS = range(6)
 KEY = "competence_ring1"
@@ -181,7 +182,7 @@ def test_the_page_writes_every_trials_values_and_every_test(batches, tmp_path, c
     tests = pd.read_csv(out / "ladder.csv")
     assert {"key", "kind", "from", "to", "mean", "low", "high", "p", "n", "p_holm"} <= set(tests)
     # Every trial in its own world, with who computed it (the trials' provenance.json).
-    trials = pd.read_csv(out / "ladder-trials.csv").query("tested == 'own'")
+    trials = read_trial_data(out / "ladder-trials.csv").query("tested == 'own'")
     assert sorted(zip(trials["rung"], trials["seed"], strict=True)) == [
         ("a", 0),
         ("a", 1),
@@ -351,7 +352,7 @@ def test_every_number_of_the_page_is_computed_again_from_its_per_trial_data_alon
     configs = {r: _config("kinematic") for r in levels}
     rungs = [ladder.Rung(r, Path(r)) for r in ("A", "B", "C")]
     files = ladder_files(_read(values, configs), rungs, [ladder.Rung("D", Path("D"))], "cmd")
-    trials = pd.read_csv(io.BytesIO(files[ladder_data.FILE]))
+    trials = read_trial_data(io.BytesIO(files[ladder_data.FILE]))
     tests = pd.read_csv(io.BytesIO(files["ladder.csv"]))
     page = files["ladder.md"].decode()
     own = trials[trials["tested"] == "own"]

@@ -18,6 +18,7 @@ from trial_recompute import ladder_case, page_table, study_headline
 from experiments.analysis.trial_tests import holm, survives
 from experiments.report import ladder
 from experiments.report.paired_text import cell_text, level_text
+from experiments.report.trial_data import read_trial_data
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 # Each published ladder page (`playroom ladder`) and the per-trial data beside it.
@@ -40,7 +41,7 @@ def _rungs(text: str) -> tuple[list[str], list[str]]:
 @pytest.fixture(scope="module", params=PAGES)
 def page(request):
     text = (DOCS / request.param).read_text()
-    trials = pd.read_csv(DOCS / "data" / PAGES[request.param])
+    trials = read_trial_data(DOCS / "data" / PAGES[request.param])
     order, beside = _rungs(text)
     measures = study_headline()
     own = trials[trials["tested"] == ladder.OWN]

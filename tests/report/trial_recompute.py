@@ -16,6 +16,7 @@ import pytest
 from scipy import stats
 
 from experiments.analysis.trial_tests import holm
+from experiments.report.trial_data import read_trial_data
 
 
 def _approx(x: float):
@@ -87,7 +88,7 @@ def check_trials_file(out: Path, page: str, tests: list[dict]) -> pd.DataFrame:
     `tests` its summary.json's tests): linked from the page, who learned and evaluated each
     trial recorded, and every test of the page computed again from it. Returns the table."""
     assert 'href="comparison-trials.csv"' in page
-    trials = pd.read_csv(out / "comparison-trials.csv")
+    trials = read_trial_data(out / "comparison-trials.csv")
     assert trials["computed_commit"].str.fullmatch(r"[0-9a-f]{7}(\+dirty)?").all()
     assert trials["computed_on"].str.contains("from iteration 0").all()
     assert trials["evaluated_on"].ne("not recorded").all()
