@@ -48,9 +48,10 @@ COMPETENCE = ("competence_all", "competence_ring1", "competence_ring2", "compete
 # The page's one family of tests, fixed by the rungs and the measures before any value is read
 # (`family` lists it; the page prints this): Holm's correction runs over all of it.
 FAMILY = (
-    "every headline measure: each step, the whole (first rung to last) and each rung beside "
-    "the ladder against the last rung, on the seeds every rung holds, and the whole on every "
-    "seed of the first and last rungs where they hold more seeds than every rung does",
+    "every headline measure: each step, the whole (first rung to last) where there are more "
+    "than two rungs (of two, the whole is the one step, tested once), and each rung beside the "
+    "ladder against the last rung, on the seeds every rung holds, and the whole on every seed "
+    "of the first and last rungs where they hold more seeds than every rung does",
     "every competence measure: each of those comparisons in each test world (kinematic, "
     "physical), split in its two parts (both rungs' agents tested there; the rungs' own "
     "worlds against it); a part whose rungs were not tested in that world is a test that "
@@ -162,9 +163,11 @@ def common_seeds(values: pd.DataFrame, order: list[str]) -> set[int]:
 
 def _comparisons(order: list[str], beside: list[str]) -> list[tuple[str, str, str]]:
     """(kind, from, to) of every comparison the page makes: each step, the whole (first rung to
-    last) and each rung beside the ladder against the last rung."""
+    last) where there are more than two rungs, and each rung beside the ladder against the last
+    rung. Of two rungs the whole is the one step: tested once, not twice in Holm's m."""
     steps = [(STEP, a, b) for a, b in pairwise(order)]
-    return [*steps, (WHOLE, order[0], order[-1]), *((BESIDE, order[-1], r) for r in beside)]
+    whole = [(WHOLE, order[0], order[-1])] if len(steps) > 1 else []
+    return [*steps, *whole, *((BESIDE, order[-1], r) for r in beside)]
 
 
 FAMILY_COLUMNS = ["key", "kind", "from", "to", "world", "part"]
@@ -178,9 +181,10 @@ def family(
     step_split part). `ends_hold_more`: the first and last rungs hold seeds some rung lacks."""
     rows = []
     comparisons = _comparisons(order, beside)
+    ladder = [c for c in comparisons if c[0] != BESIDE]
     whole_all = [(WHOLE_ALL, order[0], order[-1])] if ends_hold_more else []
     for h in measures:
-        for kind, a, b in [*comparisons[: len(order)], *whole_all, *comparisons[len(order) :]]:
+        for kind, a, b in [*ladder, *whole_all, *comparisons[len(ladder) :]]:
             rows.append({"key": h.key, "kind": kind, "from": a, "to": b, "world": OWN})
             rows[-1]["part"] = STEP
     for key in COMPETENCE:

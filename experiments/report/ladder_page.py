@@ -84,9 +84,11 @@ def steps_table(
     beside: list[str],
 ) -> list[str]:
     """Rows: measures; columns: the first rung's mean, each step, the last rung's mean, the
-    whole difference, the whole on every seed and each rung beside."""
+    whole difference (of more than two rungs), the whole on every seed and each rung beside."""
     head = [f"{order[0]} (mean)", *(f"{a} -> {b}" for a, b in pairwise(order))]
-    head += [f"{order[-1]} (mean)", "whole (first to last)"]
+    head.append(f"{order[-1]} (mean)")
+    if len(order) > 2:  # of two rungs, the whole is the one step (ladder._comparisons)
+        head.append("whole (first to last)")
     if (steps["kind"] == ladder.WHOLE_ALL).any():
         head.append("whole, every seed of the first and last rungs")
     head += [f"{order[-1]} -> {r} (beside)" for r in beside]

@@ -173,6 +173,7 @@ def test_the_page_writes_every_trials_values_and_every_test(batches, tmp_path, c
     assert main(["ladder", *rungs, "--out", str(out)]) == 0
     page = (out / "ladder.md").read_text()
     assert "## Each rung's step" in page and "No test here pools" in page
+    assert "whole (first to last)" not in page and "(whole)" not in page  # two rungs: one step
     record = json.loads((out / "ladder.json").read_text())
     seeds = {v["seed"] for v in record["values"] if v["rung"] == "a"}
     assert seeds == {0, 1}
@@ -384,3 +385,16 @@ def test_the_verdict_tells_rungs_holding_other_seeds_from_trials_missing_a_test_
     untested = values[~((values["rung"] == "C") & (values["tested"] == "physical"))]
     verdict = completeness_verdict(ladder.completeness(untested, ["A", "B", "C"]))
     assert verdict.startswith("Incomplete") and "C (physical)" in verdict
+
+
+def test_of_two_rungs_the_whole_is_the_one_step_tested_once():
+    """A ladder of two rungs has one step, which is its whole: the family tests it once (a
+    duplicate would double Holm's m), and the page has no whole column or rows."""
+    declared = ladder.family(["A", "B"], [], _headline(), ends_hold_more=False)
+    assert set(declared["kind"]) == {"step"}
+    assert not declared.duplicated(["key", "from", "to", "world", "part"]).any()
+    values = _values({r: LEVELS[r] for r in ("A", "B")})
+    steps = ladder.step_tests(values, ["A", "B"], [], _headline())
+    splits = ladder.split_tests(values, ["A", "B"], [])
+    assert len(steps) + len(splits) == len(declared)
+    assert list(steps["kind"]) == ["step"]
