@@ -14,7 +14,7 @@ from experiments.analysis.trial_tests import ALPHA, survives
 from experiments.report import ablation_data, ablation_tests
 from experiments.report.ablation_tests import AblationRow
 from experiments.report.measures import GAP, Measure
-from experiments.report.pages import p_value
+from experiments.report.pages import p_value, survive
 
 # The study's regions, in the order the table shows them (experiments.measure.study_measure).
 STUDY_REGIONS = ("centre", "between_limits", "distance_1")
@@ -78,7 +78,7 @@ def family_lines(rows: list[AblationRow], measures: tuple[Measure, ...]) -> list
         "",
         f"{n['made']} of them could be made (a comparison with fewer than 2 pairs, or whose "
         "every pair is equal, has no p and does not count in Holm's m). Holm's correction at "
-        f"{ALPHA:g} over them: {n['t']} survive with the t, {n['rank']} with the Wilcoxon "
+        f"{ALPHA:g} over them: {survive(n['t'])} with the t, {n['rank']} with the Wilcoxon "
         "signed-rank test.",
     ]
 

@@ -26,6 +26,7 @@ from experiments.analysis import step_split
 from experiments.analysis.results import ReportError, check_out_dir
 from experiments.report import ladder, ladder_data
 from experiments.report.ladder_page import completeness_lines, json_records, rungs_table
+from experiments.report.pages import survive
 from experiments.report.paired_text import cell_text, level_text
 from experiments.trial_dir import provenance, storage
 
@@ -118,7 +119,7 @@ def markdown(
         "",
         f"One family of {n['family']} tests ({len(CONTRASTS)} contrasts of each of "
         f"{len(read.measures)} measures), fixed by the cells and the measures before any value "
-        f"was read; {n['made']} could be made. Holm's correction over them: {n['t']} survive "
+        f"was read; {n['made']} could be made. Holm's correction over them: {survive(n['t'])} "
         f"with the paired t, {n['rank']} with the signed-rank test.",
         "",
         "## Where the t and the signed-rank test disagree on a star",

@@ -21,7 +21,7 @@ from experiments.analysis.trial_tests import ALPHA, survives
 from experiments.report import ladder, ladder_data, rung_change
 from experiments.report.figures import png_bytes
 from experiments.report.ladder_figure import waterfall
-from experiments.report.pages import machines_text, p_value, seeds_text
+from experiments.report.pages import machines_text, p_value, seeds_text, survive
 from experiments.report.paired_text import cell_text, level_text
 from experiments.trial_dir import provenance, storage
 
@@ -151,7 +151,7 @@ def family_lines(steps: pd.DataFrame, splits: pd.DataFrame) -> list[str]:
     lines.append(
         f"{n['made']} of them could be made (a comparison whose every pair is equal, or whose "
         f"rungs were not tested in a world, has no p and does not count in Holm's m). Holm's "
-        f"correction at {ALPHA} over them: {n['t']} survive with the paired t, {n['rank']} with "
+        f"correction at {ALPHA} over them: {survive(n['t'])} with the paired t, {n['rank']} with "
         "the Wilcoxon signed-rank test."
     )
     return lines

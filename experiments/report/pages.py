@@ -70,6 +70,11 @@ def p_value(p: float) -> str:
 FEW_TRIALS = 5
 
 
+def survive(n: int) -> str:
+    """ "N survive", or "1 survives": how many tests survive a correction, as the pages say it."""
+    return f"{n} survives" if n == 1 else f"{n} survive"
+
+
 def interval_notes(low: float, high: float, n: int) -> list[str]:
     """Warnings for an interval that would mislead as printed: zero width (all trials equal,
     or narrower than the 0.1% printed) and fewer than FEW_TRIALS trials behind it."""

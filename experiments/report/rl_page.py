@@ -23,7 +23,7 @@ from experiments.report import rl_comparison as rl
 from experiments.report.figures import png_bytes
 from experiments.report.ladder import COMPETENCE
 from experiments.report.ladder_page import json_records
-from experiments.report.pages import machines_text, p_value, seeds_text
+from experiments.report.pages import machines_text, p_value, seeds_text, survive
 from experiments.report.paired_text import level_text, signed_text
 from experiments.trial_dir import storage
 
@@ -122,7 +122,7 @@ def markdown(
         "intervals, agents in brackets; the difference is SAC + HER's minus Model Babbling's, "
         "paired by seed, with the paired t test's two-sided p and its pairs. Shares in percent "
         f"(points for differences). {n_tests} tests; Holm's correction over all of them, "
-        f"{n_kept} survive (marked *, α = 0.05).",
+        f"{survive(n_kept)} (marked *, α = 0.05).",
         "",
         *_settings_lines(mb, sac, grasps),
         "",

@@ -17,6 +17,7 @@ from trial_recompute import ladder_case, page_table, study_headline
 
 from experiments.analysis.trial_tests import holm, survives
 from experiments.report import ladder
+from experiments.report.pages import survive
 from experiments.report.paired_text import cell_text, level_text
 from experiments.report.trial_data import read_trial_data
 
@@ -106,4 +107,4 @@ def test_the_holm_counts_follow_from_the_recomputed_family(page):
     rank = int(sum(survives(p) for p in made["p_rank_holm"]))
     assert f"One family of {len(tests)} tests" in text
     assert f"{len(made)} of them could be made" in text
-    assert f"{t} survive with the paired t, {rank} with the Wilcoxon" in text
+    assert f"{survive(t)} with the paired t, {rank} with the Wilcoxon" in text

@@ -16,6 +16,7 @@ import pytest
 from scipy import stats
 
 from experiments.analysis.trial_tests import holm
+from experiments.report.pages import survive
 from experiments.report.trial_data import read_trial_data
 
 
@@ -180,7 +181,7 @@ def check_factorial_page(page: str, trials: pd.DataFrame, measures: list) -> Non
     t = int(sum(survives(p) for p in made["p_holm"]))
     rank = int(sum(survives(p) for p in made["p_rank_holm"]))
     assert f"One family of {len(tests)} tests" in page and f"; {len(made)} could be made." in page
-    assert f"{t} survive with the paired t, {rank} with the signed-rank test." in page
+    assert f"{survive(t)} with the paired t, {rank} with the signed-rank test." in page
 
 
 def study_headline() -> list:
