@@ -16,13 +16,8 @@ from pathlib import Path
 import pandas as pd
 
 from experiments.analysis.batch_checks import shared_config
-from experiments.analysis.results import (
-    BatchResults,
-    ReportError,
-    _eval_numbers,
-    _evaluation_table,
-    _read_json,
-)
+from experiments.analysis.results import BatchResults, ReportError, _read_json
+from experiments.analysis.trial_rows import eval_numbers, evaluation_table
 from experiments.trial_dir import storage
 from experiments.trial_dir.baseline_run import BASELINE_RUN_MARK, open_baseline_run
 from experiments.trial_dir.evaluation import TABLES
@@ -118,11 +113,11 @@ def collect_baselines(runs_dir: str | os.PathLike) -> BaselineResults:
                 "babbling": summary.get("babbling"),
                 "iterations": summary.get("iterations"),
                 "n_placements": summary.get("n_placements"),
-                **_eval_numbers(run.evaluation().path, summary),
+                **eval_numbers(run.evaluation().path, summary),
             }
         )
         for kind, rows in tables.items():
-            rows.append(_evaluation_table(run.evaluation(), kind, summary).assign(**keys))
+            rows.append(evaluation_table(run.evaluation(), kind, summary).assign(**keys))
     return BaselineResults(
         runs_dir=root,
         trials=pd.DataFrame(trials),

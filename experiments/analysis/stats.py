@@ -19,7 +19,8 @@ from numpy.typing import ArrayLike
 from scipy import stats
 
 from experiments.analysis.geometry import Geometry
-from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
+from experiments.analysis.results import BatchResults
+from experiments.analysis.trial_rows import COMPETENCE_SCOPES
 
 STRATEGIES = ("hand", "tool", "vocal")
 # Toys at least this far from the arm's base count as "at distance 1" (paper, Fig. 4).

@@ -24,9 +24,10 @@ import pandas as pd
 from experiments.analysis import pooled_tests, trial_values
 from experiments.analysis.geometry import Geometry
 from experiments.analysis.mechanisms import LABELS
-from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
+from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import STRATEGIES, TOOL_MIN_MOTION, regions
 from experiments.analysis.strategies import DEFINITIONS, MOVERS
+from experiments.analysis.trial_rows import COMPETENCE_SCOPES
 from experiments.analysis.trial_tests import PooledTest
 from experiments.analysis.trial_values import VALUE
 from experiments.report import measure_notes as notes

@@ -18,8 +18,9 @@ import numpy as np
 import pandas as pd
 from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
 
-from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
+from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import STRATEGIES
+from experiments.analysis.trial_rows import COMPETENCE_SCOPES
 from experiments.report.figures import FigureFile
 from experiments.trial_dir import storage
 

@@ -43,8 +43,9 @@ import numpy as np
 import pandas as pd
 
 from experiments.analysis.mechanisms import LABELS
-from experiments.analysis.results import COMPETENCE_SCOPES, BatchResults
+from experiments.analysis.results import BatchResults
 from experiments.analysis.stats import STRATEGIES
+from experiments.analysis.trial_rows import COMPETENCE_SCOPES
 from experiments.batch_files import SUMMARY_CSV_FILE, SUMMARY_JSON_FILE
 from experiments.report.differences import Evaluated, per_trial_values, tests_summary
 from experiments.report.measures import Measure

@@ -10,7 +10,7 @@ import math
 import pytest
 
 from experiments.analysis.logs import read_log
-from experiments.analysis.results import _eval_numbers
+from experiments.analysis.trial_rows import eval_numbers
 from experiments.cli.main import main
 from experiments.run.settings import TrialSettings, resume_settings
 from experiments.run.trial import run_trial
@@ -243,7 +243,7 @@ def test_an_infinite_best_distance_is_null_in_eval_json_and_read_back_as_infinit
     storage.write_json(tmp_path / "eval.json", storage.finite_or_null(summary))
     text = (tmp_path / "eval.json").read_text()
     assert "Infinity" not in text and "null" in text
-    numbers = _eval_numbers(tmp_path, storage.read_json(tmp_path / "eval.json"))
+    numbers = eval_numbers(tmp_path, storage.read_json(tmp_path / "eval.json"))
     assert numbers["median_names"] == math.inf and numbers["median_distractors"] == math.inf
 
 
